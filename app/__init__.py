@@ -1,0 +1,3 @@
+"""ShadeLab: an interactive lab for illumination and shading."""
+
+__version__ = "0.1.0"

@@ -1,0 +1,1 @@
+"""The one place OpenGL contexts, programs and render targets are made (moderngl + PyOpenGL)."""

@@ -1,0 +1,1 @@
+"""The raster renderer (moderngl): passes over a Scene into a render target."""

@@ -1,0 +1,195 @@
+"""The raster renderer: a Scene drawn as an ordered list of passes into a RenderTarget.
+
+Geometry lives on the GPU keyed by each object's geometry (:func:`geometry_key`), so a slider
+that changes a coefficient re-sets uniforms only; nothing is re-uploaded.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import moderngl
+import numpy as np
+
+from app.geometry.mesh import MeshData, geometry_key, object_mesh, scene_bounds
+from app.gl.programs import load_program, set_uniform, set_uniform_array
+from app.gl.target import RenderTarget
+from app.scene.camera import far_plane, gl_matrix, projection_matrix, view_matrix
+from app.scene.model import MAX_LIGHTS, Light, Material, Scene
+
+SHADING_PROGRAMS = ("flat", "gouraud", "phong")
+LIGHT_KIND_CODES = {"point": 0, "directional": 1, "spot": 2}
+ATTENUATION_CODES = {"none": 0, "inverse_square": 1, "lecture": 2}
+
+# Interleaved per-corner vertex layout shared by every shading program.
+VERTEX_FORMAT = "3f 3f 3f 3f 2f"
+VERTEX_ATTRIBUTES = ("in_position", "in_normal", "in_face_normal", "in_centroid", "in_uv")
+
+
+@dataclass
+class GpuMesh:
+    """One object's triangle soup on the GPU, with one VAO per shading program."""
+
+    key: tuple
+    mesh: MeshData
+    vbo: moderngl.Buffer
+    vaos: dict[str, moderngl.VertexArray]
+
+    def release(self) -> None:
+        for vao in self.vaos.values():
+            vao.release()
+        self.vbo.release()
+
+
+def triangle_soup(mesh: MeshData) -> np.ndarray:
+    """(3F, 14) float32: position, corner normal, face normal, centroid, uv per corner."""
+    tri = mesh.triangles
+    faces = len(mesh.faces)
+    centroid = np.repeat(tri.mean(axis=1)[:, None, :], 3, axis=1)
+    face_n = np.repeat(mesh.face_normals[:, None, :], 3, axis=1)
+    uv = mesh.uvs[mesh.faces]
+    soup = np.concatenate([tri, mesh.corner_normals, face_n, centroid, uv], axis=2)
+    return np.ascontiguousarray(soup.reshape(faces * 3, 14), dtype=np.float32)
+
+
+@dataclass
+class View:
+    """Camera matrices for one frame (pyrr row-vector layout)."""
+
+    clip_from_world: np.ndarray
+    eye: np.ndarray
+    size: tuple[int, int]
+
+
+def make_view(scene: Scene, size: tuple[int, int], meshes: list[MeshData],
+              infinite_far: bool = False) -> View:
+    """The scene camera's view for an image of ``size`` = (width, height) pixels."""
+    aspect = size[0] / size[1]
+    far = math.inf if infinite_far else far_plane(scene.camera, scene_bounds(meshes))
+    clip_from_world = view_matrix(scene.camera) @ projection_matrix(scene.camera, aspect, far)
+    return View(clip_from_world, np.asarray(scene.camera.eye, dtype=np.float64), size)
+
+
+class Renderer:
+    """Draws a Scene with flat, Gouraud or Phong shading on any moderngl context."""
+
+    def __init__(self, ctx: moderngl.Context):
+        self.ctx = ctx
+        self.programs = {name: load_program(ctx, name) for name in SHADING_PROGRAMS}
+        self._gpu: dict[int, GpuMesh] = {}
+
+    # ------------------------------------------------------------ geometry
+    def sync(self, scene: Scene) -> list[GpuMesh]:
+        """Upload objects whose geometry changed; reuse the rest."""
+        live = []
+        for index, obj in enumerate(scene.objects):
+            key = geometry_key(obj, scene.base_dir)
+            gpu = self._gpu.get(index)
+            if gpu is None or gpu.key != key:
+                if gpu is not None:
+                    gpu.release()
+                gpu = self._upload(key, object_mesh(obj, index, scene.base_dir))
+                self._gpu[index] = gpu
+            gpu.mesh.material = obj.material
+            live.append(gpu)
+        for index in [i for i in self._gpu if i >= len(scene.objects)]:
+            self._gpu.pop(index).release()
+        return live
+
+    def _upload(self, key: tuple, mesh: MeshData) -> GpuMesh:
+        vbo = self.ctx.buffer(triangle_soup(mesh).tobytes())
+        vaos = {}
+        for name, program in self.programs.items():
+            layout = [a if a in program else None for a in VERTEX_ATTRIBUTES]
+            fmt = _padded_format(layout)
+            vaos[name] = self.ctx.vertex_array(program, [(vbo, fmt, *[a for a in layout if a])])
+        return GpuMesh(key, mesh, vbo, vaos)
+
+    # ------------------------------------------------------------ uniforms
+    def set_frame_uniforms(self, program: moderngl.Program, scene: Scene, view: View,
+                           specular: str) -> None:
+        set_uniform(program, "u_clip_from_world", gl_matrix(view.clip_from_world))
+        set_uniform(program, "u_eye", tuple(view.eye))
+        set_uniform(program, "u_Ia", tuple(scene.Ia))
+        set_uniform(program, "u_specular_model", 1 if specular == "blinn" else 0)
+        write_light_uniforms(program, scene.active_lights())
+
+    @staticmethod
+    def set_material_uniforms(program: moderngl.Program, material: Material) -> None:
+        for name in ("ka", "kd", "ks", "n"):
+            set_uniform(program, f"u_{name}", float(getattr(material, name)))
+        set_uniform(program, "u_Od", tuple(material.Od))
+        set_uniform(program, "u_Os", tuple(material.Os))
+        set_uniform(program, "u_emission", tuple(material.emission))
+
+    # ------------------------------------------------------------ passes
+    def render(self, scene: Scene, target: RenderTarget, shading: str | None = None,
+               specular: str | None = None) -> View:
+        """Draw one frame into ``target``; returns the view used."""
+        shading = shading or scene.render.shading
+        specular = specular or scene.render.specular
+        gpu_meshes = self.sync(scene)
+        view = make_view(scene, target.size, [g.mesh for g in gpu_meshes])
+        # --- PASS 1: clear color, depth and stencil
+        target.clear(scene.render.background)
+        # --- PASS 2: ambient + every light in one additive-free pass (S_i = 1)
+        self.ctx.enable_only(moderngl.DEPTH_TEST)
+        program = self.programs[shading]
+        self.set_frame_uniforms(program, scene, view, specular)
+        set_uniform(program, "u_ambient_on", 1.0)
+        self.draw_objects(scene, gpu_meshes, shading)
+        return view
+
+    def draw_objects(self, scene: Scene, gpu_meshes: list[GpuMesh], shading: str) -> None:
+        program = self.programs[shading]
+        for gpu in gpu_meshes:
+            self.set_material_uniforms(program, scene.materials[gpu.mesh.material])
+            gpu.vaos[shading].render(moderngl.TRIANGLES)
+
+    def release(self) -> None:
+        for gpu in self._gpu.values():
+            gpu.release()
+        self._gpu.clear()
+        for program in self.programs.values():
+            program.release()
+
+
+def _padded_format(layout: list[str | None]) -> str:
+    """Buffer format with unused attributes skipped as padding (``12x`` / ``8x``)."""
+    parts = []
+    for fmt, name in zip(VERTEX_FORMAT.split(), layout):
+        count = int(fmt[0])
+        parts.append(fmt if name else f"{count * 4}x")
+    return " ".join(parts)
+
+
+def write_light_uniforms(program: moderngl.Program, lights: list[Light],
+                         shadow: list[float] | None = None) -> None:
+    """Fill the ``u_light_*`` arrays of ``lighting.glsl`` (padded to MAX_LIGHTS)."""
+    count = min(len(lights), MAX_LIGHTS)
+    kinds = np.zeros(MAX_LIGHTS, np.int32)
+    att = np.zeros(MAX_LIGHTS, np.int32)
+    pos = np.zeros((MAX_LIGHTS, 3), np.float32)
+    direction = np.zeros((MAX_LIGHTS, 3), np.float32)
+    ip = np.zeros((MAX_LIGHTS, 3), np.float32)
+    c = np.zeros((MAX_LIGHTS, 3), np.float32)
+    spot = np.zeros((MAX_LIGHTS, 2), np.float32)
+    s = np.ones(MAX_LIGHTS, np.float32)
+    for i, light in enumerate(lights[:count]):
+        kinds[i] = LIGHT_KIND_CODES[light.kind]
+        att[i] = ATTENUATION_CODES[light.attenuation]
+        pos[i] = light.position
+        d = np.asarray(light.direction, dtype=np.float64)
+        direction[i] = d / max(np.linalg.norm(d), 1e-30)
+        ip[i] = light.Ip
+        c[i] = (light.c1, light.c2, light.c3)
+        spot[i] = (math.cos(math.radians(light.cone_angle)), light.spot_exponent)
+        if shadow is not None:
+            s[i] = shadow[i]
+    set_uniform(program, "u_num_lights", count)
+    for name, array in (("u_light_kind", kinds), ("u_light_attenuation", att),
+                        ("u_light_position", pos), ("u_light_direction", direction),
+                        ("u_light_Ip", ip), ("u_light_c", c), ("u_light_spot", spot),
+                        ("u_light_S", s)):
+        set_uniform_array(program, name, array)

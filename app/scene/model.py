@@ -1,0 +1,191 @@
+"""The scene as plain data: camera, lights, materials, objects and render settings.
+
+Every field carries a validation spec in its metadata (``spec``), so the preset loader, the
+``--set`` overrides, the viewer's sliders and ``presets/schema.json`` all read one table.
+The classes are mutable on purpose: the viewer edits them live, one slider at a time.
+Names follow the lecture (``Ia``, ``ka``, ``kd``, ``ks``, ``n``, ``Od``, ``Os``, ``Ip``,
+``kt``, ``Ot``) so that a ``--set`` path reads like the slide.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+Rgb = tuple[float, float, float]
+Point3 = tuple[float, float, float]
+Vec3 = tuple[float, float, float]
+
+SCHEMA_VERSION = 1
+MAX_LIGHTS = 16  # the GLSL light arrays hold this many
+
+SHADING_MODES = ("flat", "gouraud", "phong")
+SPECULAR_MODELS = ("phong", "blinn")
+LIGHT_KINDS = ("point", "directional", "spot")
+ATTENUATION_MODES = ("none", "inverse_square", "lecture")
+NORMALS_MODES = ("flat", "average", "area", "angle", "crease")
+SHAPES = ("sphere", "box", "plane", "quad", "cylinder", "cone", "torus", "capsule", "mesh")
+TRANSPARENCY_MODELS = ("interpolated", "filtered")
+
+
+def spec(default: Any, kind: str, *args: Any, doc: str = "") -> Any:
+    """Declare a dataclass field with a validation spec.
+
+    kind is one of ``float`` (min, max), ``int`` (min, max), ``bool``, ``str`` (choices or
+    None), ``rgb`` (three finite floats >= 0), ``vec3`` (three finite floats), ``vec3s``
+    (a list of vec3), ``scale`` (a float or a vec3 of positive floats).
+    """
+    meta = {"spec": (kind, *args), "doc": doc}
+    if isinstance(default, (list, dict)):
+        return field(default_factory=lambda: type(default)(default), metadata=meta)
+    return field(default=default, metadata=meta)
+
+
+INF = float("inf")
+
+
+@dataclass
+class Camera:
+    """A pinhole camera; ``fov_y`` is the full vertical field of view in degrees."""
+
+    eye: Point3 = spec((0.0, 1.0, 5.0), "vec3", doc="camera position, world units")
+    target: Point3 = spec((0.0, 0.0, 0.0), "vec3", doc="point looked at")
+    up: Vec3 = spec((0.0, 1.0, 0.0), "vec3", doc="up direction")
+    fov_y: float = spec(45.0, "float", 1.0, 170.0, doc="vertical field of view, degrees")
+    near: float = spec(0.1, "float", 1e-6, INF, doc="near clipping distance, world units")
+
+
+@dataclass
+class Light:
+    """A point, directional or spot light of RGB intensity ``Ip``.
+
+    ``direction`` is the way the light travels (a directional light's rays; a spot's axis);
+    the shading code turns it into ``to_light`` vectors, which point away from the surface.
+    """
+
+    kind: str = spec("point", "str", LIGHT_KINDS, doc="point | directional | spot")
+    name: str = spec("", "str", None, doc="label shown in the viewer")
+    enabled: bool = spec(True, "bool", doc="switch the light off without removing it")
+    position: Point3 = spec((0.0, 5.0, 0.0), "vec3", doc="point and spot lights")
+    direction: Vec3 = spec((0.0, -1.0, 0.0), "vec3", doc="directional and spot lights")
+    Ip: Rgb = spec((1.0, 1.0, 1.0), "rgb", doc="light intensity per RGB channel")
+    attenuation: str = spec("none", "str", ATTENUATION_MODES, doc="none | inverse_square | lecture")
+    c1: float = spec(1.0, "float", 0.0, INF, doc="f_att constant term")
+    c2: float = spec(0.0, "float", 0.0, INF, doc="f_att linear term, per unit distance")
+    c3: float = spec(0.0, "float", 0.0, INF, doc="f_att quadratic term, per distance squared")
+    cone_angle: float = spec(30.0, "float", 0.0, 90.0, doc="spot half-angle, degrees")
+    spot_exponent: float = spec(1.0, "float", 0.0, 1000.0, doc="spot falloff, cos^e")
+
+
+@dataclass
+class Material:
+    """The lecture's coefficients; ``kd`` scales the diffuse color ``Od``, ``ks`` the specular ``Os``."""
+
+    ka: float = spec(0.1, "float", 0.0, 1.0, doc="ambient-reflection coefficient")
+    kd: float = spec(0.7, "float", 0.0, 1.0, doc="diffuse-reflection coefficient")
+    ks: float = spec(0.0, "float", 0.0, 1.0, doc="specular-reflection coefficient")
+    n: float = spec(10.0, "float", 0.0, 100000.0, doc="specular exponent")
+    Od: Rgb = spec((1.0, 1.0, 1.0), "rgb", doc="diffuse color")
+    Os: Rgb = spec((1.0, 1.0, 1.0), "rgb", doc="specular color")
+    kt: float = spec(0.0, "float", 0.0, 1.0, doc="transmission coefficient")
+    Ot: Rgb = spec((1.0, 1.0, 1.0), "rgb", doc="transparency color (filtered model)")
+    transparency: str = spec("interpolated", "str", TRANSPARENCY_MODELS, doc="raster model")
+    kr: float = spec(-1.0, "float", -1.0, 1.0, doc="mirror reflection; -1 = use ks")
+    ior: float = spec(1.5, "float", 1.0, 5.0, doc="index of refraction")
+    emission: Rgb = spec((0.0, 0.0, 0.0), "rgb", doc="emitted radiance (radiosity, path tracing)")
+    texture: str = spec("", "str", None, doc="'' | 'checker' | image path: modulates Od")
+    texture_scale: float = spec(8.0, "float", 1e-6, INF, doc="texture repeats across [0,1] uv")
+    texture_color2: Rgb = spec((0.1, 0.1, 0.1), "rgb", doc="checker's second color")
+    bump: str = spec("", "str", None, doc="'' | 'bumps' | height-map image path")
+    bump_scale: float = spec(1.0, "float", 0.0, 100.0, doc="bump height scale")
+
+    @property
+    def mirror(self) -> float:
+        """Reflection weight of the ray tracer: ``kr``, or the lecture's ``ks`` where unset."""
+        return self.ks if self.kr < 0.0 else self.kr
+
+
+@dataclass
+class Object:
+    """A trimesh primitive or a mesh file, placed by scale, then rotate (XYZ, degrees), then translate."""
+
+    shape: str = spec("sphere", "str", SHAPES, doc="primitive or 'mesh'")
+    name: str = spec("", "str", None, doc="label")
+    material: str = spec("default", "str", None, doc="name of a [materials.X] table")
+    path: str = spec("", "str", None, doc="mesh file (OBJ, PLY, STL, glTF/GLB), preset-relative")
+    radius: float = spec(1.0, "float", 1e-9, INF, doc="sphere, cylinder, cone, capsule, torus")
+    minor_radius: float = spec(0.25, "float", 1e-9, INF, doc="torus tube radius")
+    height: float = spec(1.0, "float", 1e-9, INF, doc="cylinder, cone, capsule")
+    extents: Vec3 = spec((1.0, 1.0, 1.0), "vec3", doc="box edge lengths")
+    size: float = spec(1.0, "float", 1e-9, INF, doc="plane edge length (xz plane, normal +y)")
+    vertices: list = spec([], "vec3s", doc="quad corners, counter-clockwise seen from the front")
+    subdivisions: int = spec(3, "int", 0, 7, doc="sphere: icosphere subdivision level")
+    sections: int = spec(32, "int", 3, 1024, doc="cylinder, cone, torus, capsule sections")
+    segments: int = spec(1, "int", 1, 512, doc="plane and quad: cells per edge")
+    translate: Vec3 = spec((0.0, 0.0, 0.0), "vec3", doc="world offset")
+    rotate: Vec3 = spec((0.0, 0.0, 0.0), "vec3", doc="XYZ Euler angles, degrees")
+    scale: Vec3 = spec((1.0, 1.0, 1.0), "vec3", doc="per-axis scale")
+    normals: str = spec("crease", "str", NORMALS_MODES, doc="vertex normal rule")
+    crease_angle: float = spec(30.0, "float", 0.0, 180.0, doc="crease mode: split above, degrees")
+    cast_shadows: bool = spec(True, "bool", doc="casts shadow volumes / blocks shadow rays")
+
+
+@dataclass
+class RenderSettings:
+    """How the raster viewer draws the scene."""
+
+    shading: str = spec("phong", "str", SHADING_MODES, doc="flat | gouraud | phong")
+    specular: str = spec("phong", "str", SPECULAR_MODELS, doc="phong (R.V)^n | blinn (N.H)^n")
+    shadows: str = spec("none", "str", ("none", "volumes"), doc="none | volumes")
+    shadow_method: str = spec("zfail", "str", ("zfail", "zpass"), doc="stencil counting")
+    visibility: str = spec("zbuffer", "str", ("zbuffer", "painter"), doc="hidden surfaces")
+    exposure: float = spec(1.0, "float", 0.0, 1e6, doc="scale applied before display")
+    background: Rgb = spec((0.0, 0.0, 0.0), "rgb", doc="clear color, linear")
+
+
+@dataclass
+class RaytraceSettings:
+    """Whitted ray tracer and path tracer settings."""
+
+    depth: int = spec(5, "int", 0, 64, doc="maximum recursion depth")
+    spp: int = spec(1, "int", 1, 65536, doc="samples per pixel (stratified)")
+    min_weight: float = spec(0.01, "float", 0.0, 1.0, doc="stop a ray below this weight")
+    offset: float = spec(1e-3, "float", 0.0, INF, doc="ray origin offset, scene-relative")
+    fresnel: bool = spec(False, "bool", doc="weight reflection/refraction by Fresnel")
+
+
+@dataclass
+class RadiositySettings:
+    """Radiosity meshing and solver settings."""
+
+    patches: int = spec(400, "int", 1, 1000000, doc="target patch count")
+    form_factors: str = spec("raycast", "str", ("hemicube", "raycast", "analytic"), doc="method")
+    solver: str = spec("progressive", "str",
+                       ("direct", "jacobi", "gauss-seidel", "progressive"), doc="solver")
+    hemicube_resolution: int = spec(128, "int", 4, 4096, doc="hemicube face resolution")
+    iterations: int = spec(200, "int", 1, 1000000, doc="maximum solver iterations")
+    tolerance: float = spec(1e-4, "float", 0.0, 1.0, doc="relative residual to stop at")
+
+
+@dataclass
+class Scene:
+    """Everything a renderer needs; ``base_dir`` resolves relative mesh and texture paths."""
+
+    description: str = spec("", "str", None, doc="what this preset teaches")
+    Ia: Rgb = spec((0.1, 0.1, 0.1), "rgb", doc="ambient intensity")
+    camera: Camera = field(default_factory=Camera)
+    lights: list[Light] = field(default_factory=list)
+    materials: dict[str, Material] = field(default_factory=dict)
+    objects: list[Object] = field(default_factory=list)
+    render: RenderSettings = field(default_factory=RenderSettings)
+    raytrace: RaytraceSettings = field(default_factory=RaytraceSettings)
+    radiosity: RadiositySettings = field(default_factory=RadiositySettings)
+    schema_version: int = SCHEMA_VERSION
+    name: str = field(default="", metadata={"internal": True})
+    base_dir: str = field(default=".", metadata={"internal": True})
+
+    def material_of(self, obj: Object) -> Material:
+        return self.materials[obj.material]
+
+    def active_lights(self) -> list[Light]:
+        return [light for light in self.lights if light.enabled]

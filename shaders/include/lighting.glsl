@@ -1,0 +1,110 @@
+// The lecture's lighting equation: the GLSL mirror of app/shading/reference.py.
+// Same function names, same argument order; tests/test_glsl_parity.py holds them together.
+// Conventions: to_light (L) and to_eye (V) point away from the surface; normals are unit;
+// colors are linear RGB.
+//
+//   I = Le + Ia ka Od + sum_i S_i f_att,i Ip,i [kd Od (N.L_i) + ks Os (R_i.V)^n]
+//   f_att = 1 | 1/d^2 | min(1/(c1 + c2 d + c3 d^2), 1);   R = 2N(N.L) - L;   H = (L+V)/|L+V|
+
+#define MAX_LIGHTS 16
+#define LIGHT_POINT 0
+#define LIGHT_DIRECTIONAL 1
+#define LIGHT_SPOT 2
+
+uniform int u_num_lights;                        // lights in use, <= MAX_LIGHTS
+uniform int u_light_kind[MAX_LIGHTS];            // LIGHT_POINT | LIGHT_DIRECTIONAL | LIGHT_SPOT
+uniform vec3 u_light_position[MAX_LIGHTS];       // world space (point, spot)
+uniform vec3 u_light_direction[MAX_LIGHTS];      // unit, the way the light travels
+uniform vec3 u_light_Ip[MAX_LIGHTS];             // RGB intensity
+uniform int u_light_attenuation[MAX_LIGHTS];     // 0 none, 1 inverse square, 2 lecture
+uniform vec3 u_light_c[MAX_LIGHTS];              // c1, c2, c3 of the lecture's f_att
+uniform vec2 u_light_spot[MAX_LIGHTS];           // cos(cone half-angle), falloff exponent
+uniform float u_light_S[MAX_LIGHTS];             // shadow factor S_i: 1 lit, 0 blocked
+
+uniform vec3 u_Ia;                               // ambient intensity
+uniform float u_ambient_on;                      // 1: add Le + Ia ka Od (first pass only)
+uniform int u_specular_model;                    // 0 Phong (R.V)^n, 1 Blinn-Phong (N.H)^n
+
+uniform float u_ka;
+uniform float u_kd;
+uniform float u_ks;
+uniform float u_n;
+uniform vec3 u_Od;
+uniform vec3 u_Os;
+uniform vec3 u_emission;
+
+const float SHADING_EPS = 1e-12;
+
+float lambert(vec3 n, vec3 to_light) {
+    return max(dot(n, to_light), 0.0);
+}
+
+vec3 reflect_light(vec3 n, vec3 to_light) {
+    return 2.0 * n * dot(n, to_light) - to_light;
+}
+
+// cos^n for cos > 0, else 0 (n = 0 gives 1 inside the lobe).
+float lobe_power(float cosine, float shininess) {
+    return cosine > 0.0 ? pow(max(cosine, SHADING_EPS), shininess) : 0.0;
+}
+
+float phong_specular(vec3 n, vec3 to_light, vec3 to_eye, float shininess) {
+    if (dot(n, to_light) <= 0.0) return 0.0;
+    return lobe_power(dot(reflect_light(n, to_light), to_eye), shininess);
+}
+
+vec3 halfway(vec3 to_light, vec3 to_eye) {
+    vec3 h = to_light + to_eye;
+    float len = length(h);
+    return len > SHADING_EPS ? h / len : vec3(0.0);
+}
+
+float blinn_phong_specular(vec3 n, vec3 to_light, vec3 to_eye, float shininess) {
+    if (dot(n, to_light) <= 0.0) return 0.0;
+    return lobe_power(dot(n, halfway(to_light, to_eye)), shininess);
+}
+
+float attenuation(float distance, int mode, vec3 c) {
+    if (mode == 1) return 1.0 / max(distance * distance, SHADING_EPS);
+    if (mode == 2) return min(1.0 / max(c.x + c.y * distance + c.z * distance * distance,
+                                        SHADING_EPS), 1.0);
+    return 1.0;
+}
+
+float spot_factor(vec3 to_light, vec3 axis, float cos_cone, float exponent) {
+    float cos_phi = dot(-to_light, axis);
+    return cos_phi >= cos_cone ? pow(max(cos_phi, 0.0), exponent) : 0.0;
+}
+
+// One light's diffuse + specular contribution at a point (S_i included).
+vec3 shade_light(int i, vec3 position, vec3 n, vec3 to_eye, vec3 od) {
+    vec3 to_light;
+    float f_att = 1.0;
+    float spot = 1.0;
+    if (u_light_kind[i] == LIGHT_DIRECTIONAL) {
+        to_light = -u_light_direction[i];
+    } else {
+        vec3 delta = u_light_position[i] - position;
+        float distance = length(delta);
+        to_light = distance > SHADING_EPS ? delta / distance : vec3(0.0);
+        f_att = attenuation(distance, u_light_attenuation[i], u_light_c[i]);
+        if (u_light_kind[i] == LIGHT_SPOT)
+            spot = spot_factor(to_light, u_light_direction[i], u_light_spot[i].x,
+                               u_light_spot[i].y);
+    }
+    float specular = u_specular_model == 1
+        ? blinn_phong_specular(n, to_light, to_eye, u_n)
+        : phong_specular(n, to_light, to_eye, u_n);
+    vec3 scale = u_light_S[i] * f_att * spot * u_light_Ip[i];
+    return scale * (u_kd * od * lambert(n, to_light) + u_ks * u_Os * specular);
+}
+
+vec3 shade(vec3 position, vec3 n, vec3 eye, vec3 od) {
+    vec3 to_eye = eye - position;
+    float len = length(to_eye);
+    to_eye = len > SHADING_EPS ? to_eye / len : vec3(0.0);
+    vec3 color = u_ambient_on * (u_emission + u_Ia * u_ka * od);
+    for (int i = 0; i < u_num_lights; ++i)
+        color += shade_light(i, position, n, to_eye, od);
+    return color;
+}

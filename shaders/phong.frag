@@ -1,0 +1,16 @@
+#version 330
+#include "lighting"
+
+uniform vec3 u_eye;
+
+in vec3 v_position;
+in vec3 v_normal;
+in vec2 v_uv;
+
+out vec4 f_color;
+
+void main() {
+    vec3 n = normalize(v_normal);
+    if (!gl_FrontFacing) n = -n;   // seen from behind: light the back
+    f_color = vec4(shade(v_position, n, u_eye, u_Od), 1.0);
+}
