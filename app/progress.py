@@ -1,0 +1,49 @@
+"""The contract between offline renderers (ray tracing, path tracing, radiosity) and their
+consumers (the CLI's tqdm bar, the viewer's side panel, benchmarks).
+
+An offline render is a generator that yields :class:`Progress` after each pass, tile or
+iteration. The consumer cancels by closing the generator (``gen.close()``) or simply by not
+asking for more; the renderer must stop promptly between chunks (keep chunks well under 0.2 s
+so the viewer's Cancel button feels immediate). Pure module: no GL, no GUI.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Iterator
+
+import numpy as np
+
+
+@dataclass
+class Progress:
+    """One step of an offline render.
+
+    Attributes
+    ----------
+    image : (H, W, 3) float32 linear radiance so far (row 0 at the top), or None
+    fraction : float in [0, 1], how much of the job is done
+    message : short status line for the progress bar ("pass 3/16", "iteration 40")
+    stats : figures to report at the end (rays/s, depth reached, residual, patch count, ...)
+    """
+
+    image: np.ndarray | None
+    fraction: float
+    message: str = ""
+    stats: dict = field(default_factory=dict)
+
+
+def run_to_end(jobs: Iterator[Progress], desc: str = "", show: bool = True) -> Progress:
+    """Drive a progressive job to completion with a tqdm bar; return the last Progress."""
+    from tqdm import tqdm
+
+    last = None
+    with tqdm(total=1000, desc=desc, disable=not show, unit="‰", leave=False) as bar:
+        for step in jobs:
+            bar.update(int(step.fraction * 1000) - bar.n)
+            if step.message:
+                bar.set_postfix_str(step.message, refresh=False)
+            last = step
+    if last is None:
+        raise RuntimeError("offline render produced no result")
+    return last
