@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import os
 from pathlib import Path
 
 import numpy as np
@@ -36,11 +35,20 @@ def check_writable(path: str | None, flag: str) -> None:
     """Fail before any work if ``path`` cannot be written (nothing is half-written later)."""
     if not path:
         return
-    folder = Path(path).resolve().parent
+    target = Path(path)
+    folder = target.resolve().parent
     if not folder.is_dir():
         raise ShadeLabError(f"{flag} '{path}': folder '{folder}' does not exist")
-    if not os.access(folder, os.W_OK) or (Path(path).exists() and not os.access(path, os.W_OK)):
-        raise ShadeLabError(f"{flag} '{path}': not writable")
+    if target.is_dir():
+        raise ShadeLabError(f"{flag} '{path}': is a folder, expected a file name")
+    existed = target.exists()
+    try:  # append mode: an existing file is left as it is
+        with open(target, "ab"):
+            pass
+    except OSError as exc:
+        raise ShadeLabError(f"{flag} '{path}': not writable ({exc.strerror})") from None
+    if not existed:
+        target.unlink(missing_ok=True)
 
 
 def write_png(path: str, linear: np.ndarray, exposure: float = 1.0) -> None:

@@ -1,0 +1,48 @@
+"""Shared fixtures: the one headless GL context, a seeded RNG, golden-image comparison."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+GOLDEN_DIR = Path(__file__).resolve().parent / "golden"
+OUTPUT_DIR = Path(__file__).resolve().parent / "_output"
+
+
+def pytest_addoption(parser):
+    parser.addoption("--update-golden", action="store_true",
+                     help="regenerate golden images instead of comparing")
+
+
+@pytest.fixture(scope="session")
+def gl_ctx():
+    """The process's headless EGL context (this is the only place tests get one)."""
+    from app.errors import ShadeLabError
+    from app.gl.context import headless_context
+
+    try:
+        ctx = headless_context()
+    except ShadeLabError as exc:
+        pytest.skip(f"no EGL: {exc}")
+    _ = ctx.error
+    yield ctx
+    assert ctx.error == "GL_NO_ERROR"
+
+
+@pytest.fixture
+def np_rng():
+    return np.random.default_rng(20261122)
+
+
+@pytest.fixture
+def update_golden(request) -> bool:
+    return bool(request.config.getoption("--update-golden"))
+
+
+@pytest.fixture(autouse=True)
+def _isolated_state(tmp_path, monkeypatch):
+    """Keep autosaves and other user state of tests out of the real home."""
+    monkeypatch.setenv("XDG_STATE_HOME", str(tmp_path / "state"))
