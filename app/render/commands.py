@@ -17,6 +17,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--specular", choices=SPECULAR_MODELS, help="phong (R.V)^n or blinn (N.H)^n")
     p.add_argument("--shadows", choices=("none", "volumes"), help="stencil shadow volumes")
     p.add_argument("--shadow-method", choices=("zfail", "zpass"), help="stencil counting")
+    p.add_argument("--error", type=float, metavar="BUDGET",
+                   help="auto quality: tessellate each sphere no finer than this relative MSE "
+                        "needs (e.g. 0.01; see app.studies.autoquality)")
     p.set_defaults(run=run_render)
 
     p = sub.add_parser("presets", help="list the presets shipped with ShadeLab")
@@ -34,8 +37,19 @@ def run_render(args: argparse.Namespace) -> int:
         if getattr(args, flag, None):
             overrides.append(f"{key}={getattr(args, flag)}")
     scene = load_preset(args.preset, overrides)
+    if getattr(args, "error", None) is not None:
+        from app.studies.autoquality import check_budget
+
+        check_budget(args.error)
     check_outputs(args)
     from app.render.offscreen import render_image  # GL only once the input is known good
+
+    if getattr(args, "error", None) is not None:
+        from app.studies.autoquality import auto_tessellate
+
+        shading = args.shading or scene.render.shading
+        for line in auto_tessellate(scene, shading, size, args.error, args.specular):
+            print(line)
 
     image = render_image(scene, size, args.shading, args.specular)
     save_outputs(args, image, scene.render.exposure)

@@ -1,0 +1,109 @@
+"""``shadelab charts`` (speed-vs-accuracy PNG + CSV) and ``shadelab gallery`` (failure cases)."""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from pathlib import Path
+
+from app.errors import ShadeLabError
+
+# (name, module, function): each function is run_<study>(quick) -> StudyResult
+STUDIES = (
+    ("shading", "app.studies.shading_study", "run_shading"),
+    ("raytrace", "app.studies.raytrace_study", "run_raytrace"),
+    ("radiosity", "app.studies.radiosity_study", "run_radiosity"),
+    ("shadows", "app.studies.shadow_study", "run_shadows"),
+)
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("charts", help="speed-vs-accuracy charts (PNG + CSV)")
+    p.add_argument("--out", default="charts", metavar="DIR", help="folder to write (created)")
+    p.add_argument("--quick", action="store_true", help="small images, few repeats (smoke run)")
+    p.add_argument("--only", action="append", default=[], metavar="STUDY",
+                   help=f"run only these studies ({', '.join(s for s, _, _ in STUDIES)})")
+    p.set_defaults(run=run_charts)
+
+    p = sub.add_parser("gallery", help="render the failure gallery, one PNG per case")
+    p.add_argument("--out", default="gallery", metavar="DIR", help="folder to write (created)")
+    p.add_argument("--size", default="160x120", metavar="WxH", help="image size per case")
+    p.add_argument("--only", action="append", default=[], metavar="CASE",
+                   help="render only these cases (names from app.studies.gallery)")
+    p.set_defaults(run=run_gallery)
+
+
+def make_out_dir(text: str) -> Path:
+    """Create the output folder (and parents) or fail with one line."""
+    path = Path(text)
+    if path.exists() and not path.is_dir():
+        raise ShadeLabError(f"--out '{text}': exists and is not a folder")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ShadeLabError(f"--out '{text}': cannot create folder ({exc.strerror})") from None
+    return path
+
+
+def run_study(name: str, quick: bool):
+    """Import and run one study; returns its StudyResult or raises StudySkipped."""
+    from app.studies.result import StudySkipped
+
+    for study, module_name, function in STUDIES:
+        if study == name:
+            try:
+                module = importlib.import_module(module_name)
+            except ModuleNotFoundError as exc:
+                raise StudySkipped(f"{name}: module {exc.name} is not built yet") from None
+            return getattr(module, function)(quick)
+    raise KeyError(name)
+
+
+def run_charts(args: argparse.Namespace) -> int:
+    known = [s for s, _, _ in STUDIES]
+    for name in args.only:
+        if name not in known:
+            raise ShadeLabError(f"--only '{name}': expected one of {', '.join(known)}")
+    out = make_out_dir(args.out)
+    from app.studies.charts import write_chart
+    from app.studies.result import StudySkipped
+
+    for name in known:
+        if args.only and name not in args.only:
+            continue
+        print(f"charts: {name} ...", file=sys.stderr, flush=True)
+        try:
+            result = run_study(name, bool(args.quick))
+        except StudySkipped as exc:
+            print(f"skipped {name}: {exc}")
+            continue
+        for path in write_chart(result, out):
+            print(f"wrote {path}")
+        for note in result.notes:
+            print(f"  {note}")
+    return 0
+
+
+def run_gallery(args: argparse.Namespace) -> int:
+    from app.imageio import parse_size, write_png
+    from app.studies.gallery import GALLERY, GallerySkipped, render_case
+
+    size = parse_size(args.size)
+    names = [case.name for case in GALLERY]
+    for name in args.only:
+        if name not in names:
+            raise ShadeLabError(f"--only '{name}': expected one of {', '.join(names)}")
+    out = make_out_dir(args.out)
+    for case in GALLERY:
+        if args.only and case.name not in args.only:
+            continue
+        try:
+            image, exposure = render_case(case, size)
+        except GallerySkipped as exc:
+            print(f"skipped {case.name}: {exc}")
+            continue
+        path = out / f"{case.name}.png"
+        write_png(str(path), image, exposure)
+        print(f"wrote {path}")
+    return 0

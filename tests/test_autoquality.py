@@ -1,0 +1,80 @@
+"""Auto quality: the cheapest setting on the measured front within an error budget."""
+
+from __future__ import annotations
+
+import pytest
+
+from app.cli import main
+from app.errors import ShadeLabError
+from app.studies.autoquality import FrontPoint, choose_setting, pareto_front
+
+FRONT = [FrontPoint({"level": k}, cost=20 * 4 ** k, error=0.1 / 3.5 ** k) for k in range(6)]
+
+
+def _check_choice(points, budget):
+    """The chosen point meets the budget and the next cheaper front point does not."""
+    front = pareto_front(points)
+    choice = choose_setting(points, budget)
+    assert choice.met and choice.point.error <= budget
+    i = front.index(choice.point)
+    if i > 0:
+        assert front[i - 1].error > budget and front[i - 1].cost < choice.point.cost
+    return choice
+
+
+@pytest.mark.parametrize("budget", [0.2, 0.05, 0.01, 1e-3, 3e-4])
+def test01_synthetic_front(budget):
+    choice = _check_choice(FRONT, budget)
+    expected = min(k for k in range(6) if 0.1 / 3.5 ** k <= budget)
+    assert choice.point.setting == {"level": expected}
+
+
+def test02_dominated_points_are_dropped():
+    slow_and_bad = FrontPoint({"level": 9}, cost=1e6, error=1.0)
+    front = pareto_front([*FRONT, slow_and_bad])
+    assert slow_and_bad not in front
+    assert [p.cost for p in front] == sorted(p.cost for p in front)
+    assert all(a.error > b.error for a, b in zip(front, front[1:], strict=False))
+
+
+def test03_unreachable_budget_returns_best_unmet():
+    choice = choose_setting(FRONT, 1e-9)
+    assert not choice.met and choice.point.setting == {"level": 5}
+
+
+@pytest.mark.parametrize("budget", [0.0, -1.0, float("nan"), float("inf")])
+def test04_bad_budget_is_an_error(budget):
+    with pytest.raises(ShadeLabError):
+        choose_setting(FRONT, budget)
+    with pytest.raises(ShadeLabError):
+        choose_setting([], 0.01)
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("shading", ["flat", "gouraud", "phong"])
+def test05_measured_tessellation_front(gl_ctx, shading):
+    from app.studies.autoquality import front_from_rows
+    from app.studies.shading_study import COLUMNS, measure_sphere, study_scene
+
+    rows = measure_sphere(study_scene(), 0, shading, (48, 48), repeats=1)
+    records = [dict(zip(COLUMNS, r, strict=True)) for r in rows]
+    points = front_from_rows(records, ("level",), "triangles")
+    for budget in (0.02, 2e-3):
+        if pareto_front(points)[-1].error <= budget:
+            _check_choice(points, budget)
+
+
+@pytest.mark.gl
+def test06_render_error_flag(gl_ctx, tmp_path, capsys):
+    out = tmp_path / "x.png"
+    assert main(["render", "sphere-shading", "-o", str(out), "--size", "48x36",
+                 "--shading", "phong", "--error", "0.01"]) == 0
+    text = capsys.readouterr().out
+    assert "auto quality: objects.0" in text and "<= 0.01" in text and out.is_file()
+
+
+@pytest.mark.parametrize("value", ["0", "-0.5", "nan", "abc"])
+def test07_render_error_flag_bad_input(tmp_path, capsys, value):
+    code = main(["render", "sphere-shading", "-o", str(tmp_path / "x.png"), "--error", value])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "--error" in err
