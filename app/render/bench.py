@@ -1,0 +1,93 @@
+"""Raster benchmark: frame time per preset and shading mode, time to first image, and a bare
+moderngl per-fragment Phong draw of the same triangles for a noise-proof ratio."""
+
+from __future__ import annotations
+
+import time
+
+import moderngl
+import numpy as np
+
+from app.bench import median_time
+from app.geometry.mesh import scene_meshes
+from app.gl.context import create_headless_context, headless_context
+from app.gl.programs import load_program, set_uniform
+from app.gl.target import RenderTarget
+from app.render.renderer import Renderer, make_view, triangle_soup
+from app.scene.camera import gl_matrix
+from app.scene.preset import list_presets, load_preset
+
+SIZE = (800, 600)
+
+
+def time_to_first_image() -> float:
+    """Seconds from a new EGL context to the first cornell image read back."""
+    start = time.perf_counter()
+    ctx = create_headless_context()
+    renderer = Renderer(ctx)
+    target = RenderTarget(ctx, SIZE)
+    renderer.render(load_preset("cornell"), target)
+    target.read()
+    elapsed = time.perf_counter() - start
+    renderer.release()
+    target.release()
+    ctx.release()
+    return elapsed
+
+
+def bare_phong_frame(ctx: moderngl.Context, preset: str, repeats: int) -> dict:
+    """The same triangles in one VAO, one light, a plain framebuffer: the floor we compare to."""
+    scene = load_preset(preset)
+    meshes = scene_meshes(scene)
+    soup = np.concatenate([triangle_soup(m)[:, :6] for m in meshes]).astype("f4")
+    program = load_program(ctx, "bare_phong")
+    vbo = ctx.buffer(soup.tobytes())
+    vao = ctx.vertex_array(program, [(vbo, "3f 3f", "in_position", "in_normal")])
+    fbo = ctx.framebuffer(ctx.texture(SIZE, 4, dtype="f4"), ctx.depth_renderbuffer(SIZE))
+    view = make_view(scene, SIZE, meshes)
+    set_uniform(program, "u_clip_from_world", gl_matrix(view.clip_from_world))
+    set_uniform(program, "u_eye", tuple(view.eye))
+    set_uniform(program, "u_light_position", tuple(scene.lights[0].position))
+    set_uniform(program, "u_light_Ip", tuple(scene.lights[0].Ip))
+    set_uniform(program, "u_Od", (0.7, 0.7, 0.7))
+
+    def frame():
+        fbo.use()
+        fbo.clear(0.0, 0.0, 0.0, 1.0, depth=1.0)
+        ctx.enable_only(moderngl.DEPTH_TEST)
+        vao.render(moderngl.TRIANGLES)
+        ctx.finish()
+
+    result = median_time(frame, repeats)
+    for res in (vao, vbo, program, fbo):
+        res.release()
+    return result
+
+
+def run(quick: bool) -> dict:
+    ctx = headless_context()
+    renderer = Renderer(ctx)
+    target = RenderTarget(ctx, SIZE)
+    repeats = 5 if quick else 40
+    frames = {}
+    presets = ["cornell", "sphere-shading"] if quick else list_presets()
+    for name in presets:
+        scene = load_preset(name)
+        for shading in ("flat", "gouraud", "phong"):
+            def frame(scene=scene, shading=shading):
+                renderer.render(scene, target, shading)
+                ctx.finish()
+
+            frames[f"{name}/{shading}"] = median_time(frame, repeats)
+    bare = bare_phong_frame(ctx, "cornell", repeats)
+    ours = frames["cornell/phong"]["median_ms"]
+    renderer.release()
+    target.release()
+    return {
+        "size": list(SIZE),
+        "frame_ms": frames,
+        "bare_moderngl_phong_cornell": bare,
+        "cornell_phong_over_bare": ours / bare["median_ms"],
+        "time_to_first_image_s": time_to_first_image(),
+        "goal": "cornell_phong_over_bare <= 1.3",
+    }
