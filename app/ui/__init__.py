@@ -1,0 +1,1 @@
+"""The interactive viewer (imgui-bundle): AppState, panels, the GL viewport, offline jobs."""

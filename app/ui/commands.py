@@ -1,0 +1,92 @@
+"""``shadelab view [PRESET]`` (also plain ``shadelab [PRESET]``): the interactive viewer."""
+
+from __future__ import annotations
+
+import argparse
+import os
+
+from app.errors import ShadeLabError
+
+DEFAULT_PRESET = "cornell"
+NO_DISPLAY = ("no display (DISPLAY and WAYLAND_DISPLAY are unset): use 'shadelab render PRESET "
+              "-o OUT.png' for images without a window, or install Xvfb and run "
+              "'xvfb-run -a shadelab'")
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("view", help="open the interactive viewer (default preset: cornell)")
+    p.add_argument("preset", nargs="?", metavar="PRESET",
+                   help="preset name from presets/ or a path (default: the last session, or "
+                        "cornell)")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a preset value, e.g. materials.white.kd=0.5")
+    p.add_argument("--fresh", action="store_true", help="ignore the autosaved session")
+    p.add_argument("--window", default="1600x900", metavar="WxH", help="window size")
+    p.add_argument("--frames", type=int, default=0, metavar="N", help="quit after N frames")
+    p.add_argument("--screenshot", metavar="PATH", help="write a PNG of the window at exit")
+    p.add_argument("--compare", action="store_true", help="start in 2x2 compare mode")
+    p.add_argument("--diff", action="store_true", help="with --compare: show the heat map")
+    p.add_argument("--probe", metavar="X,Y", help="probe this viewport pixel at start")
+    p.add_argument("--job", metavar="NAME", help="start this offline render at start "
+                   "(e.g. 'reference', 'whitted', 'path', 'radiosity'); --frames counts "
+                   "after it ends")
+    p.add_argument("--presenter", action="store_true", help="large fonts for a projector")
+    p.add_argument("--wireframe", action="store_true", help="show the wireframe")
+    p.add_argument("--normals", action="store_true", help="show normal glyphs")
+    p.add_argument("--help-overlay", action="store_true", help="show the shortcut help")
+    p.add_argument("--no-autosave", action="store_true", help="do not write the session")
+    p.add_argument("--bench-json", help=argparse.SUPPRESS)
+    p.set_defaults(run=run_view)
+
+
+def _pixel(text: str) -> tuple[int, int]:
+    try:
+        x, y = (int(v) for v in text.split(","))
+    except ValueError:
+        raise ShadeLabError(f"--probe '{text}': expected X,Y viewport pixel, e.g. 300,200") \
+            from None
+    if x < 0 or y < 0:
+        raise ShadeLabError(f"--probe '{text}': expected non-negative pixel coordinates")
+    return x, y
+
+
+def load_scene(args: argparse.Namespace):
+    """The scene to open: the autosaved session if it matches, else the preset."""
+    from app.scene.preset import load_preset
+    from app.ui.state import load_session
+
+    if not args.fresh and not args.set:
+        session = load_session()
+        if session is not None and args.preset in (None, session[1]):
+            print(f"shadelab: restored the autosaved session of '{session[1]}' "
+                  f"(--fresh to start from the preset)")
+            return session
+    name = args.preset or DEFAULT_PRESET
+    return load_preset(name, args.set), name
+
+
+def run_view(args: argparse.Namespace) -> int:
+    if not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
+        raise ShadeLabError(NO_DISPLAY)
+    from app.imageio import check_writable, parse_size
+
+    window = parse_size(args.window)
+    check_writable(args.screenshot, "--screenshot")
+    probe = _pixel(args.probe) if args.probe else None
+    if args.frames < 0:
+        raise ShadeLabError(f"--frames {args.frames}: expected a count >= 0")
+    scene, source = load_scene(args)
+    from app.geometry.mesh import scene_meshes
+
+    scene_meshes(scene)  # a broken mesh file fails here, with its one-line reason
+    from app.ui.app import ViewerOptions, run_viewer
+    from app.ui.state import AppState
+
+    state = AppState.from_scene(scene, source)
+    state.compare, state.diff_enabled = args.compare, args.diff
+    state.presenter, state.show_help = args.presenter, args.help_overlay
+    state.show_wireframe, state.show_normals = args.wireframe, args.normals
+    options = ViewerOptions(frames=args.frames, screenshot=args.screenshot or "",
+                            window_size=window, probe=probe, job=args.job or "",
+                            bench_json=args.bench_json or "", autosave=not args.no_autosave)
+    return run_viewer(state, options)

@@ -1,0 +1,37 @@
+#version 330
+// Display pass: linear radiance -> exposure -> sRGB, or a heat map of |a - b| (compare mode).
+uniform sampler2D t_image;      // linear RGB radiance (RGBA32F)
+uniform sampler2D t_other;      // second image for the difference heat map
+uniform int u_mode;             // 0: tone map t_image, 1: heat map of |t_image - t_other|
+uniform float u_exposure;       // scale applied before display
+uniform float u_diff_scale;     // heat map: this difference (after exposure) is full red
+
+in vec2 v_uv;
+out vec4 f_color;
+
+vec3 to_srgb(vec3 linear) {
+    vec3 c = clamp(linear, 0.0, 1.0);
+    vec3 lo = 12.92 * c;
+    vec3 hi = 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055;
+    return mix(hi, lo, vec3(lessThanEqual(c, vec3(0.0031308))));
+}
+
+// Black -> blue -> green -> yellow -> red as t goes 0 -> 1.
+vec3 heat(float t) {
+    float s = clamp(t, 0.0, 1.0) * 4.0;
+    if (s < 1.0) return mix(vec3(0.0), vec3(0.0, 0.0, 1.0), s);
+    if (s < 2.0) return mix(vec3(0.0, 0.0, 1.0), vec3(0.0, 1.0, 0.0), s - 1.0);
+    if (s < 3.0) return mix(vec3(0.0, 1.0, 0.0), vec3(1.0, 1.0, 0.0), s - 2.0);
+    return mix(vec3(1.0, 1.0, 0.0), vec3(1.0, 0.0, 0.0), s - 3.0);
+}
+
+void main() {
+    vec3 a = texture(t_image, v_uv).rgb * u_exposure;
+    if (u_mode == 1) {
+        vec3 b = texture(t_other, v_uv).rgb * u_exposure;
+        vec3 d = abs(a - b);
+        f_color = vec4(heat(max(d.r, max(d.g, d.b)) / max(u_diff_scale, 1e-12)), 1.0);
+    } else {
+        f_color = vec4(to_srgb(a), 1.0);
+    }
+}
