@@ -89,7 +89,7 @@ def run(args: argparse.Namespace) -> int:
         try:
             module = importlib.import_module(module_name)
         except ModuleNotFoundError as exc:
-            if exc.name == module_name:
+            if exc.name and module_name.startswith(exc.name):
                 continue
             raise
         print(f"bench: {name} ...", file=sys.stderr, flush=True)

@@ -42,7 +42,7 @@ def build_parser() -> argparse.ArgumentParser:
         try:
             module = importlib.import_module(name)
         except ModuleNotFoundError as exc:
-            if exc.name == name:  # a layer not built yet contributes nothing
+            if exc.name and name.startswith(exc.name):  # a layer not built yet: no command
                 continue
             raise
         module.add_parser(sub)

@@ -50,6 +50,8 @@ def bare_phong_frame(ctx: moderngl.Context, preset: str, repeats: int) -> dict:
     set_uniform(program, "u_light_position", tuple(scene.lights[0].position))
     set_uniform(program, "u_light_Ip", tuple(scene.lights[0].Ip))
     set_uniform(program, "u_Od", (0.7, 0.7, 0.7))
+    set_uniform(program, "u_ks", 0.0)  # a uniform: the compiler cannot drop the specular term
+    set_uniform(program, "u_n", 10.0)
 
     def frame():
         fbo.use()

@@ -49,8 +49,8 @@ float lobe_power(float cosine, float shininess) {
 }
 
 float phong_specular(vec3 n, vec3 to_light, vec3 to_eye, float shininess) {
-    if (dot(n, to_light) <= 0.0) return 0.0;
-    return lobe_power(dot(reflect_light(n, to_light), to_eye), shininess);
+    float lobe = lobe_power(dot(reflect_light(n, to_light), to_eye), shininess);
+    return dot(n, to_light) > 0.0 ? lobe : 0.0;
 }
 
 vec3 halfway(vec3 to_light, vec3 to_eye) {
@@ -60,15 +60,15 @@ vec3 halfway(vec3 to_light, vec3 to_eye) {
 }
 
 float blinn_phong_specular(vec3 n, vec3 to_light, vec3 to_eye, float shininess) {
-    if (dot(n, to_light) <= 0.0) return 0.0;
-    return lobe_power(dot(n, halfway(to_light, to_eye)), shininess);
+    float lobe = lobe_power(dot(n, halfway(to_light, to_eye)), shininess);
+    return dot(n, to_light) > 0.0 ? lobe : 0.0;
 }
 
 float attenuation(float distance, int mode, vec3 c) {
-    if (mode == 1) return 1.0 / max(distance * distance, SHADING_EPS);
-    if (mode == 2) return min(1.0 / max(c.x + c.y * distance + c.z * distance * distance,
-                                        SHADING_EPS), 1.0);
-    return 1.0;
+    float inverse_square = 1.0 / max(distance * distance, SHADING_EPS);
+    float lecture = min(1.0 / max(c.x + c.y * distance + c.z * distance * distance,
+                                  SHADING_EPS), 1.0);
+    return mode == 1 ? inverse_square : (mode == 2 ? lecture : 1.0);
 }
 
 float spot_factor(vec3 to_light, vec3 axis, float cos_cone, float exponent) {
@@ -78,23 +78,20 @@ float spot_factor(vec3 to_light, vec3 axis, float cos_cone, float exponent) {
 
 // One light's diffuse + specular contribution at a point (S_i included).
 vec3 shade_light(int i, vec3 position, vec3 n, vec3 to_eye, vec3 od) {
-    vec3 to_light;
-    float f_att = 1.0;
+    // Branch-free where it is cheap: llvmpipe runs divergent branches under masks.
+    int kind = u_light_kind[i];
+    vec3 delta = u_light_position[i] - position;
+    float distance = length(delta);
+    vec3 to_point = distance > SHADING_EPS ? delta / distance : vec3(0.0);
+    bool directional = kind == LIGHT_DIRECTIONAL;
+    vec3 to_light = directional ? -u_light_direction[i] : to_point;
+    float f_att = directional ? 1.0 : attenuation(distance, u_light_attenuation[i], u_light_c[i]);
     float spot = 1.0;
-    if (u_light_kind[i] == LIGHT_DIRECTIONAL) {
-        to_light = -u_light_direction[i];
-    } else {
-        vec3 delta = u_light_position[i] - position;
-        float distance = length(delta);
-        to_light = distance > SHADING_EPS ? delta / distance : vec3(0.0);
-        f_att = attenuation(distance, u_light_attenuation[i], u_light_c[i]);
-        if (u_light_kind[i] == LIGHT_SPOT)
-            spot = spot_factor(to_light, u_light_direction[i], u_light_spot[i].x,
-                               u_light_spot[i].y);
-    }
-    float specular = u_specular_model == 1
-        ? blinn_phong_specular(n, to_light, to_eye, u_n)
-        : phong_specular(n, to_light, to_eye, u_n);
+    if (kind == LIGHT_SPOT)
+        spot = spot_factor(to_light, u_light_direction[i], u_light_spot[i].x, u_light_spot[i].y);
+    float specular;
+    if (u_specular_model == 1) specular = blinn_phong_specular(n, to_light, to_eye, u_n);
+    else specular = phong_specular(n, to_light, to_eye, u_n);
     vec3 scale = u_light_S[i] * f_att * spot * u_light_Ip[i];
     return scale * (u_kd * od * lambert(n, to_light) + u_ks * u_Os * specular);
 }
