@@ -78,6 +78,7 @@ class Renderer:
         self.ctx = ctx
         self.programs = {name: load_program(ctx, name) for name in SHADING_PROGRAMS}
         self._gpu: dict[int, GpuMesh] = {}
+        self._shadows = None  # app.render.shadows.ShadowVolumes, made on first use
 
     # ------------------------------------------------------------ geometry
     def sync(self, scene: Scene) -> list[GpuMesh]:
@@ -129,17 +130,101 @@ class Renderer:
         """Draw one frame into ``target``; returns the view used."""
         shading = shading or scene.render.shading
         specular = specular or scene.render.specular
+        settings = scene.render
         gpu_meshes = self.sync(scene)
-        view = make_view(scene, target.size, [g.mesh for g in gpu_meshes])
-        # --- PASS 1: clear color, depth and stencil
-        target.clear(scene.render.background)
-        # --- PASS 2: ambient + every light in one additive-free pass (S_i = 1)
-        self.ctx.enable_only(moderngl.DEPTH_TEST)
+        lights = scene.active_lights()[:MAX_LIGHTS]
+        painter = settings.visibility == "painter"
+        shadowed = settings.shadows == "volumes" and bool(lights) and not painter
+        # Shadow volumes reach infinity (w = 0): the whole frame then uses an infinite far plane.
+        view = make_view(scene, target.size, [g.mesh for g in gpu_meshes], infinite_far=shadowed)
+        opaque = [g for g in gpu_meshes if not is_transparent(scene.materials[g.mesh.material])]
+        clear = [g for g in gpu_meshes if is_transparent(scene.materials[g.mesh.material])]
         program = self.programs[shading]
+        # --- PASS 1: clear color, depth and stencil
+        target.clear(settings.background)
+        if painter:
+            # --- PASS 2 (list priority): every triangle back to front, no depth test
+            from app.render.painter import draw_painter
+
+            self.set_frame_uniforms(program, scene, view, specular)
+            set_uniform(program, "u_ambient_on", 1.0)
+            draw_painter(self, scene, gpu_meshes, shading, view)
+            return view
+        # --- PASS 2: opaque surfaces, ambient + every light in one pass (S_i = 1);
+        #     with shadow volumes: ambient + emission only (the lights come in pass 3)
+        self.ctx.enable_only(moderngl.DEPTH_TEST)
         self.set_frame_uniforms(program, scene, view, specular)
+        if shadowed:
+            write_light_uniforms(program, [])
         set_uniform(program, "u_ambient_on", 1.0)
-        self.draw_objects(scene, gpu_meshes, shading)
+        self.draw_objects(scene, opaque, shading)
+        # --- PASS 3: per light, a stencil count of its shadow volumes (z-fail or z-pass),
+        #     then that light alone added where the count is 0 (S_i = 1), nowhere else
+        if shadowed:
+            self._shadow_passes(scene, target, view, gpu_meshes, opaque, lights, shading)
+        # --- PASS 4: transparent surfaces back to front, blended by their model
+        #     (interpolated or filtered), depth-tested against the opaque ones
+        if clear:
+            from app.render.transparency import draw_transparent
+
+            self.set_frame_uniforms(program, scene, view, specular)
+            set_uniform(program, "u_ambient_on", 1.0)
+            draw_transparent(self, scene, clear, shading, view)
+        # --- PASS 5: teaching overlays: stencil heat map, translucent volumes, silhouettes
+        if shadowed and (settings.stencil_heatmap or settings.show_volumes
+                         or settings.show_silhouettes):
+            self._shadow_overlays(scene, target, view, gpu_meshes, lights)
+        self.ctx.enable_only(moderngl.DEPTH_TEST)
         return view
+
+    @property
+    def shadow_volumes(self):
+        """The stencil shadow-volume helper (made on first use)."""
+        if self._shadows is None:
+            from app.render.shadows import ShadowVolumes
+
+            self._shadows = ShadowVolumes(self.ctx)
+        return self._shadows
+
+    def _shadow_passes(self, scene: Scene, target: RenderTarget, view: View, gpu_meshes,
+                       opaque, lights: list[Light], shading: str) -> None:
+        shadows = self.shadow_volumes
+        shadows.drop_lights_from(len(lights))
+        program = self.programs[shading]
+        set_uniform(program, "u_ambient_on", 0.0)
+        for index, light in enumerate(lights):
+            volumes = shadows.volumes(scene, gpu_meshes, index, light)
+            shadows.count(target, view, volumes, scene.render.shadow_method)
+            self.ctx.enable_only(moderngl.DEPTH_TEST | moderngl.BLEND)
+            self.ctx.blend_func = moderngl.ONE, moderngl.ONE
+            self.ctx.depth_func = "<="
+            shadows.lit_where_zero()
+            write_light_uniforms(program, [light])
+            self.draw_objects(scene, opaque, shading)
+        shadows.stencil_off()
+        self.ctx.depth_func = "<"
+        target.fbo.depth_mask = True
+        target.fbo.use()
+        write_light_uniforms(program, lights)
+        set_uniform(program, "u_ambient_on", 1.0)
+
+    def _shadow_overlays(self, scene: Scene, target: RenderTarget, view: View, gpu_meshes,
+                         lights: list[Light]) -> None:
+        shadows = self.shadow_volumes
+        settings = scene.render
+        index = min(settings.heatmap_light, len(lights) - 1)
+        volumes = shadows.volumes(scene, gpu_meshes, index, lights[index])
+        if settings.stencil_heatmap:
+            shadows.count(target, view, volumes, settings.shadow_method)
+            shadows.heatmap()
+        if settings.show_volumes:
+            for i, light in enumerate(lights):
+                shadows.draw_translucent(view, shadows.volumes(scene, gpu_meshes, i, light))
+        if settings.show_silhouettes:
+            for i, light in enumerate(lights):
+                shadows.draw_silhouettes(view, shadows.volumes(scene, gpu_meshes, i, light))
+        target.fbo.depth_mask = True
+        target.fbo.use()
 
     def draw_objects(self, scene: Scene, gpu_meshes: list[GpuMesh], shading: str) -> None:
         program = self.programs[shading]
@@ -153,12 +238,20 @@ class Renderer:
         self._gpu.clear()
         for program in self.programs.values():
             program.release()
+        if self._shadows is not None:
+            self._shadows.release()
+            self._shadows = None
+
+
+def is_transparent(material: Material) -> bool:
+    """Drawn in the blended pass: the lecture's transmission coefficient kt is above 0."""
+    return material.kt > 0.0
 
 
 def _padded_format(layout: list[str | None]) -> str:
     """Buffer format with unused attributes skipped as padding (``12x`` / ``8x``)."""
     parts = []
-    for fmt, name in zip(VERTEX_FORMAT.split(), layout):
+    for fmt, name in zip(VERTEX_FORMAT.split(), layout, strict=True):
         count = int(fmt[0])
         parts.append(fmt if name else f"{count * 4}x")
     return " ".join(parts)

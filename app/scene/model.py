@@ -141,6 +141,10 @@ class RenderSettings:
     visibility: str = spec("zbuffer", "str", ("zbuffer", "painter"), doc="hidden surfaces")
     exposure: float = spec(1.0, "float", 0.0, 1e6, doc="scale applied before display")
     background: Rgb = spec((0.0, 0.0, 0.0), "rgb", doc="clear color, linear")
+    show_volumes: bool = spec(False, "bool", doc="draw the shadow volumes, translucent")
+    show_silhouettes: bool = spec(False, "bool", doc="highlight the casters' silhouette edges")
+    stencil_heatmap: bool = spec(False, "bool", doc="overlay one light's stencil count")
+    heatmap_light: int = spec(0, "int", 0, 15, doc="which light the stencil heat map shows")
 
 
 @dataclass

@@ -1,0 +1,168 @@
+"""Shadow-volume geometry: silhouette edges, caps and extrusion to infinity (numpy/trimesh only).
+
+A light is a homogeneous point ``(x, y, z, w)``: ``w = 1`` for point and spot lights, ``w = 0``
+for a directional light (``xyz`` = towards the light, i.e. minus its travel direction).
+
+Volume faces are wound counter-clockwise seen from outside the volume, so the stencil pass can
+count back faces up and front faces down (z-fail, Carmack's reverse). Extruded vertices are
+points at infinity: ``w = 0`` and ``xyz`` = the direction away from the light.
+
+Casters
+-------
+* Closed, consistently wound meshes (``trimesh`` watertight and winding-consistent) get one
+  volume bounded by the silhouette edges (edges between a light-facing and a dark face), a
+  near cap made of the dark faces (reversed) and a far cap of the dark faces projected to
+  infinity. Using the *dark* side as the near cap keeps the light-facing surface off the
+  volume's boundary, so lit faces never self-shadow through depth ties.
+* Anything else (open surfaces such as the Cornell box's quads, or inconsistently wound
+  meshes) gets one small closed volume per triangle: the triangle turned to face the light
+  (near cap), its three edges extruded, and the reversed triangle at infinity (far cap).
+  This is always correct (the union of the per-triangle volumes is the shadow) but costs
+  more fill than a silhouette volume. Nothing is refused and nothing is "repaired".
+
+Every volume starts ``offset`` world units beyond the caster along the light's rays, so the
+caster's own surface lies strictly outside its volume (no self-shadowing acne).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import trimesh
+
+
+@dataclass
+class ShadowVolume:
+    """One caster's shadow volume for one light.
+
+    Attributes
+    ----------
+    vertices : (2V, 4) float64 homogeneous; rows V.. are the extruded points (w = 0)
+    faces : (K, 3) int64 into ``vertices``, counter-clockwise seen from outside the volume
+    silhouette : (E, 2) int64 silhouette edges (indices of the first V rows), wound as in
+        their light-facing face; every triangle edge in per-triangle mode
+    method : "silhouette" | "per-triangle"
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    silhouette: np.ndarray
+    method: str
+
+    def triangles(self) -> np.ndarray:
+        """(K, 3, 4) float32 triangle soup for the GPU."""
+        return self.vertices[self.faces].astype(np.float32)
+
+    def finite(self, distance: float) -> tuple[np.ndarray, np.ndarray]:
+        """The volume with infinity replaced by ``distance`` along each ray (for checks)."""
+        v = self.vertices
+        n = len(v) // 2
+        near = v[:n, :3]
+        d = v[n:, :3] / np.maximum(np.linalg.norm(v[n:, :3], axis=1, keepdims=True), 1e-300)
+        return np.concatenate([near, near + distance * d]), self.faces
+
+
+def light_homogeneous(kind: str, position, direction) -> np.ndarray:
+    """(4,) homogeneous light position for ``kind`` point | spot | directional."""
+    if kind == "directional":
+        d = np.asarray(direction, dtype=np.float64)
+        return np.append(-d / max(np.linalg.norm(d), 1e-300), 0.0)
+    return np.append(np.asarray(position, dtype=np.float64), 1.0)
+
+
+def away_from_light(points: np.ndarray, light: np.ndarray) -> np.ndarray:
+    """(N, 3) unit directions from the light through each point."""
+    if light[3] == 0.0:
+        return np.broadcast_to(-light[:3], points.shape).copy()
+    d = points - light[:3]
+    return d / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300)
+
+
+def facing_light(vertices: np.ndarray, faces: np.ndarray, light: np.ndarray) -> np.ndarray:
+    """(F,) bool: the face's front (counter-clockwise) side sees the light."""
+    tri = vertices[faces]
+    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    to_light = light[:3] - light[3] * tri.mean(axis=1)
+    return np.einsum("ij,ij->i", normal, to_light) > 0.0
+
+
+def closed_caster(vertices: np.ndarray, faces: np.ndarray) -> trimesh.Trimesh | None:
+    """The caster as a closed, consistently wound, outward-facing mesh, or None."""
+    mesh = trimesh.Trimesh(vertices, faces, process=True)
+    if len(mesh.faces) == 0 or not (mesh.is_watertight and mesh.is_winding_consistent):
+        return None
+    if mesh.volume < 0.0:  # wound inside out: same surface, turned
+        mesh.invert()
+    return mesh
+
+
+def silhouette_edges(mesh: trimesh.Trimesh, lit: np.ndarray) -> np.ndarray:
+    """(E, 2) edges between a light-facing and a dark face, wound as in the lit face."""
+    pairs = mesh.face_adjacency
+    edges = mesh.face_adjacency_edges
+    cross = lit[pairs[:, 0]] != lit[pairs[:, 1]]
+    pairs, edges = pairs[cross], edges[cross]
+    lit_face = np.where(lit[pairs[:, 0]], pairs[:, 0], pairs[:, 1])
+    f = mesh.faces[lit_face]
+    a, b = edges[:, 0], edges[:, 1]
+    # (a, b) follows the lit face's winding when b comes right after a in it.
+    forward = ((f[:, 0] == a) & (f[:, 1] == b)) | ((f[:, 1] == a) & (f[:, 2] == b)) \
+        | ((f[:, 2] == a) & (f[:, 0] == b))
+    return np.where(forward[:, None], edges, edges[:, ::-1]).astype(np.int64)
+
+
+def _sides(edges: np.ndarray, n: int) -> np.ndarray:
+    """Two triangles per edge (a, b): the quad (b, a, a_inf, b_inf), outward-facing."""
+    a, b = edges[:, 0], edges[:, 1]
+    return np.concatenate([np.stack([b, a, a + n], 1), np.stack([b, a + n, b + n], 1)])
+
+
+def _homogeneous(points: np.ndarray, light: np.ndarray, offset: float) -> np.ndarray:
+    away = away_from_light(points, light)
+    near = np.concatenate([points + offset * away, np.ones((len(points), 1))], axis=1)
+    far = np.concatenate([away, np.zeros((len(points), 1))], axis=1)
+    return np.concatenate([near, far])
+
+
+def shadow_volume(vertices: np.ndarray, faces: np.ndarray, light: np.ndarray,
+                  offset: float = 0.0) -> ShadowVolume:
+    """The shadow volume of one caster (world-space triangles) for one homogeneous light."""
+    vertices = np.asarray(vertices, dtype=np.float64)
+    faces = np.asarray(faces, dtype=np.int64)
+    mesh = closed_caster(vertices, faces)
+    if mesh is not None:
+        v = np.asarray(mesh.vertices, dtype=np.float64)
+        f = np.asarray(mesh.faces, dtype=np.int64)
+        lit = facing_light(v, f, light)
+        edges = silhouette_edges(mesh, lit)
+        n = len(v)
+        dark = f[~lit]
+        volume_faces = np.concatenate([_sides(edges, n), dark[:, ::-1], dark + n])
+        return ShadowVolume(_homogeneous(v, light, offset), volume_faces, edges, "silhouette")
+    # Per-triangle volumes: an unshared triangle soup, each turned to face the light.
+    tri = vertices[faces]
+    lit = facing_light(vertices, faces, light)
+    tri = np.where(lit[:, None, None], tri, tri[:, ::-1])
+    soup = tri.reshape(-1, 3)
+    n = len(soup)
+    caps = np.arange(n, dtype=np.int64).reshape(-1, 3)
+    edges = np.concatenate([caps[:, [0, 1]], caps[:, [1, 2]], caps[:, [2, 0]]])
+    volume_faces = np.concatenate([_sides(edges, n), caps, caps[:, ::-1] + n])
+    contour = edges[_contour_edges(faces, facing_light(vertices, faces, light))]
+    return ShadowVolume(_homogeneous(soup, light, offset), volume_faces, contour, "per-triangle")
+
+
+def _contour_edges(faces: np.ndarray, lit: np.ndarray) -> np.ndarray:
+    """(3F,) bool over the soup's edges (order 01, 12, 20): boundary edges, and edges whose
+    faces disagree about facing the light: the open caster's silhouette, for display."""
+    pairs = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    key = np.sort(pairs, axis=1)
+    _, inverse, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    inverse = inverse.reshape(-1)
+    face_lit = np.tile(lit, 3).astype(np.int64)
+    lo = np.full(len(counts), 2)
+    hi = np.full(len(counts), -1)
+    np.minimum.at(lo, inverse, face_lit)
+    np.maximum.at(hi, inverse, face_lit)
+    return (counts[inverse] == 1) | (lo[inverse] != hi[inverse])
