@@ -1,0 +1,80 @@
+"""Shadow-volume geometry (pure numpy/trimesh): silhouettes, closure, orientation, fallbacks."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import trimesh
+
+from app.geometry.silhouette import light_homogeneous, shadow_volume
+
+
+def _closed(volume, distance=50.0) -> trimesh.Trimesh:
+    vertices, faces = volume.finite(distance)
+    return trimesh.Trimesh(vertices, faces, process=False)  # connectivity by index
+
+
+def test_cube_lit_along_its_diagonal_has_a_six_edge_silhouette_loop():
+    cube = trimesh.creation.box()
+    volume = shadow_volume(cube.vertices, cube.faces,
+                           light_homogeneous("directional", None, (-1.0, -1.0, -1.0)))
+    assert volume.method == "silhouette"
+    edges = volume.silhouette
+    assert len(edges) == 6
+    # a single closed loop: every vertex has one outgoing and one incoming edge
+    assert sorted(edges[:, 0]) == sorted(edges[:, 1]) and len(set(edges[:, 0])) == 6
+    nxt = dict(edges)
+    v, seen = edges[0, 0], []
+    for _ in range(6):
+        seen.append(v)
+        v = nxt[v]
+    assert v == edges[0, 0] and len(set(seen)) == 6
+    # the two corners on the diagonal are not on the silhouette
+    corners = cube.vertices[np.unique(edges)]
+    assert not np.any(np.all(np.abs(corners - 0.5) < 1e-9, axis=1))
+    assert not np.any(np.all(np.abs(corners + 0.5) < 1e-9, axis=1))
+
+
+@pytest.mark.parametrize("light", [("point", (3.0, 4.0, 2.0), None),
+                                   ("directional", None, (0.3, -1.0, 0.2)),
+                                   ("spot", (-2.0, 3.0, -1.0), (1.0, -1.0, 0.0))])
+@pytest.mark.parametrize("shape", ["box", "sphere", "torus"])
+def test_volume_is_watertight_and_outward(shape, light):
+    mesh = {"box": trimesh.creation.box(extents=(1.0, 2.0, 0.5)),
+            "sphere": trimesh.creation.icosphere(2),
+            "torus": trimesh.creation.torus(1.0, 0.3, 16, 8)}[shape]
+    volume = shadow_volume(mesh.vertices, mesh.faces, light_homogeneous(*light), offset=0.01)
+    assert volume.method == "silhouette"
+    closed = _closed(volume)
+    assert closed.is_watertight and closed.is_winding_consistent
+    assert closed.volume > 0.0  # wound outward, as the stencil counting expects
+    assert np.all(volume.vertices[len(volume.vertices) // 2:, 3] == 0.0)  # extruded to w = 0
+
+
+def test_volume_contains_the_shadow_and_not_the_lit_side():
+    sphere = trimesh.creation.icosphere(3)
+    light = light_homogeneous("point", (0.0, 5.0, 0.0), None)
+    closed = _closed(shadow_volume(sphere.vertices, sphere.faces, light, offset=1e-3))
+    inside = closed.contains([[0.0, -2.0, 0.0], [0.0, 1.5, 0.0], [2.0, -2.0, 0.0],
+                              [0.0, 0.999, 0.0]])
+    assert inside.tolist() == [True, False, False, False]
+
+
+def test_open_and_inconsistent_casters_get_per_triangle_volumes():
+    quad = np.array([[0.0, 0, 0], [1, 0, 0], [1, 0, 1], [0, 0, 1]])
+    faces = np.array([[0, 1, 2], [0, 3, 2]])  # open, and the second triangle turned over
+    light = light_homogeneous("point", (0.5, 3.0, 0.5), None)
+    volume = shadow_volume(quad, faces, light, offset=0.01)
+    assert volume.method == "per-triangle"
+    closed = _closed(volume)
+    assert closed.is_winding_consistent and closed.volume > 0.0
+    assert closed.body_count == 2 and all(b.is_watertight for b in closed.split())
+    assert closed.contains([[0.5, -1.0, 0.5]])[0] and not closed.contains([[0.5, 0.5, 0.5]])[0]
+    assert len(volume.silhouette) == 4  # the quad's outline, not its diagonal
+
+    box = trimesh.creation.box()
+    flipped = box.faces.copy()
+    flipped[::4] = flipped[::4, ::-1]
+    volume = shadow_volume(box.vertices, flipped, light)
+    assert volume.method == "per-triangle"
+    assert _closed(volume).is_winding_consistent
