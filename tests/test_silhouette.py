@@ -69,8 +69,9 @@ def test_open_and_inconsistent_casters_get_per_triangle_volumes():
     closed = _closed(volume)
     assert closed.is_winding_consistent and closed.volume > 0.0
     assert closed.body_count == 2 and all(b.is_watertight for b in closed.split())
-    assert closed.contains([[0.5, -1.0, 0.5]])[0] and not closed.contains([[0.5, 0.5, 0.5]])[0]
-    assert len(volume.silhouette) == 4  # the quad's outline, not its diagonal
+    assert closed.contains([[0.3, -1.0, 0.6]])[0] and not closed.contains([[0.3, 0.5, 0.6]])[0]
+    consistent = shadow_volume(quad, np.array([[0, 1, 2], [0, 2, 3]]), light)
+    assert len(consistent.silhouette) == 4  # an open quad shows its outline, not its diagonal
 
     box = trimesh.creation.box()
     flipped = box.faces.copy()
