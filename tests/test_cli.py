@@ -1,0 +1,63 @@
+"""The command-line contract of DESIGN.md §3 for render, presets and validate."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from app.cli import main
+from app.scene.preset import list_presets
+
+
+@pytest.mark.gl
+def test_render_writes_png_and_linear_npy(tmp_path):
+    png, npy = tmp_path / "c.png", tmp_path / "c.npy"
+    assert main(["render", "cornell", "-o", str(png), "--npy", str(npy), "--size", "40x30",
+                 "--shading", "gouraud"]) == 0
+    image = np.load(npy)
+    assert image.dtype == np.float32 and image.shape == (30, 40, 3)
+    srgb = np.asarray(Image.open(png))
+    assert srgb.shape == (30, 40, 3)
+    # Row 0 is the top: the ceiling light (emission 20.7, 10.9, 2.8) is in the upper half.
+    brightest_row = np.unravel_index(np.argmax(image[..., 0]), image.shape[:2])[0]
+    assert brightest_row < 15
+    np.testing.assert_allclose(image.max(axis=(0, 1)), [20.71, 10.85, 2.77], rtol=1e-5)
+
+
+@pytest.mark.gl
+def test_set_changes_the_image_as_the_equation_says(tmp_path):
+    """Halving the white walls' kd halves their radiance (ka = 0, one light, no specular)."""
+    a, b = tmp_path / "a.npy", tmp_path / "b.npy"
+    base = ["--size", "32x32", "--shading", "phong"]
+    assert main(["render", "cornell", "-o", str(tmp_path / "a.png"), "--npy", str(a), *base]) == 0
+    assert main(["render", "cornell", "-o", str(tmp_path / "b.png"), "--npy", str(b), *base,
+                 "--set", "materials.white.kd=0.5"]) == 0
+    ia, ib = np.load(a), np.load(b)
+    floor = (slice(28, 31), slice(14, 18))  # the white floor near the bottom middle
+    np.testing.assert_allclose(ib[floor], 0.5 * ia[floor], rtol=1e-5)
+
+
+def test_presets_lists_every_preset(capsys):
+    assert main(["presets"]) == 0
+    out = capsys.readouterr().out
+    for name in list_presets():
+        assert name in out
+
+
+def test_validate_reports_counts(capsys):
+    assert main(["validate", "cornell"]) == 0
+    assert "19 objects, 38 triangles, 1 lights" in capsys.readouterr().out
+
+
+def test_python_dash_m_app_is_the_same_command():
+    out = subprocess.run([sys.executable, "-m", "app", "validate", "sphere-shading"],
+                         capture_output=True, text=True)
+    assert out.returncode == 0 and "ok sphere-shading" in out.stdout
+    bad = subprocess.run([sys.executable, "-m", "app", "validate", "nope"],
+                         capture_output=True, text=True)
+    assert bad.returncode == 2 and bad.stderr.startswith("shadelab: error: unknown preset")
+    assert "Traceback" not in bad.stderr
