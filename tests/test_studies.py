@@ -93,3 +93,20 @@ def test07_charts_bad_input(tmp_path, capsys):
     blocker.write_text("x")
     assert main(["charts", "--out", str(blocker)]) == 2
     assert "not a folder" in capsys.readouterr().err
+
+
+@pytest.mark.gl
+def test08_shadow_study_agrees_with_rays_except_zpass_inside(gl_ctx):
+    pytest.importorskip("app.render.shadows")
+    pytest.importorskip("app.raytrace.surface")
+    from app.studies.shadow_study import run_shadows
+
+    result = run_shadows(quick=True)
+    for row in result.records():
+        if row["scene"] == "fail-zpass-eye-inside" and row["method"] == "zpass":
+            assert row["mismatch"] > 0.5            # the eye inside a volume inverts z-pass
+        else:
+            assert row["mismatch"] < 0.02, row      # edge pixels only
+        assert row["time_ms"] > 0 and row["oracle_ms"] > 0
+    scenes = set(result.column("scene"))
+    assert {"shadows", "fail-zpass-eye-inside", "fail-open-caster"} <= scenes

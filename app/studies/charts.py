@@ -24,9 +24,11 @@ def draw_panel(ax, result: StudyResult, front: bool = True) -> None:
     """One study table on one axes: a line per group, points labelled, the Pareto front dashed."""
     from matplotlib.ticker import NullFormatter
 
+    positive = [float(v) for v in result.column(result.y) if float(v) > 0.0]
+    floor = min(positive) / 10.0 if positive else 1e-12  # zeros sit one decade below on log
     for name, rows in result.series().items():
         xs = [float(v) for v in result.column(result.x, rows)]
-        ys = [max(float(v), 1e-12) if result.log_y else float(v)
+        ys = [max(float(v), floor) if result.log_y else float(v)
               for v in result.column(result.y, rows)]
         ax.plot(xs, ys, marker="o", markersize=4, linewidth=1.2, label=name)
         if result.label:
@@ -38,7 +40,7 @@ def draw_panel(ax, result: StudyResult, front: bool = True) -> None:
                   for r in zip(result.column(result.x), result.column(result.y), strict=False)]
         best = pareto_front(points)
         if len(best) > 1:
-            ax.step([p.cost for p in best], [max(p.error, 1e-12) for p in best], where="post",
+            ax.step([p.cost for p in best], [max(p.error, floor) for p in best], where="post",
                     color="black", linestyle="--", linewidth=0.8, label="Pareto front")
     if result.log_x:
         ax.set_xscale("log")

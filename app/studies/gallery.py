@@ -64,8 +64,9 @@ GALLERY: list[GalleryCase] = [
     GalleryCase(
         "non-closed-caster", "fail-open-caster", ("render.shadows=volumes",), "raster:phong",
         "Shadow volumes need closed, consistently wound casters: an open mesh has silhouette "
-        "edges with one face, so the volume leaks and stencil counts go wrong. See the shadow "
-        "module for what an open caster gets.",
+        "edges with one face, so its volume would leak and stencil counts go wrong. ShadeLab "
+        "gives an open (or inconsistently wound) caster one small closed volume per triangle "
+        "(app.geometry.silhouette): the shadow stays right, at more fill cost.",
         T + "test05_open_caster", requires="app.render.shadows"),
     GalleryCase(
         "painter-cyclic", "fail-painter-cycle", ("render.visibility=painter",), "raster:phong",
@@ -94,7 +95,7 @@ GALLERY: list[GalleryCase] = [
         "1989). Raise radiosity.hemicube_resolution or use raycast/analytic form factors.",
         T + "test09_hemicube_aliasing", requires="app.radiosity.formfactors"),
     GalleryCase(
-        "radiosity-light-leak", "fail-light-leak", (), "radiosity",
+        "radiosity-light-leak", "radiosity-leak", (), "radiosity",
         "A patch that runs under a wall is lit as a whole, so light appears on the dark side "
         "(a leak); radiosity is constant per patch. Mesh along the contact lines or use more "
         "patches.",
