@@ -219,6 +219,8 @@ class Viewer:
         state = self.state
         avail = imgui.get_content_region_avail()
         size = (max(int(avail.x), 16), max(int(avail.y) - 4, 16))
+        if size != state.viewport_size and state.probe_pixel is not None:
+            state.probe_requested = True  # the same pixel shows another point now
         state.viewport_size = size
         if state.compare:
             self.draw_compare(size)
@@ -309,11 +311,11 @@ class Viewer:
     def update_probe(self, size: tuple[int, int]) -> None:
         """Recompute the probed pixel's terms (CPU reference) and read what the GPU drew."""
         state = self.state
-        state.probe_requested = False
         pixel = state.probe_pixel
         if pixel is None or not (0 <= pixel[0] < size[0] and 0 <= pixel[1] < size[1]):
             state.probe = None
-            return
+            return  # (kept requested: the layout may still be settling)
+        state.probe_requested = False
         result = probe(state.scene, size, pixel)
         if result is not None:
             result.gpu = self.viewport.read_pixel("main", pixel)

@@ -40,7 +40,7 @@ def start_job(state: AppState, index: int) -> None:
     if state.gl is not None:
         state.gl.draw_scene("job_raster", scene, size, kind.raster_shading, scene.render.specular)
         state.job_raster = state.gl.read_linear("job_raster")
-        state.gl.ctx.screen.use()
+        state.gl.restore()
     state.job_kind, state.job_version, state.job_compare = index, -1, None
     state.job.start(kind.label, lambda: kind.make(scene, size))
 

@@ -50,9 +50,18 @@ class Viewport:
         self.display_vao = ctx.vertex_array(self.display_program, [])
         self.panes: dict[str, Pane] = {}
         self.images: dict[str, moderngl.Texture] = {}  # CPU images (offline results)
+        self._anchor = ctx.simple_framebuffer((1, 1))
         self._line_buffer = ctx.buffer(reserve=1 << 20, dynamic=True)
         self._line_vao = ctx.vertex_array(self.lines_program,
                                           [(self._line_buffer, "3f 3f", "in_position", "in_color")])
+
+    def restore(self) -> None:
+        """Bind the window's framebuffer again (imgui draws there), or a 1x1 anchor headless.
+
+        moderngl re-binds "the previous framebuffer" after creating one; it must never be a
+        framebuffer we have deleted, so one that outlives every pane is bound before releases.
+        """
+        (self.ctx.screen or self._anchor).use()
 
     # ------------------------------------------------------------ panes
     def pane(self, key: str, size: tuple[int, int]) -> Pane:
@@ -62,6 +71,7 @@ class Viewport:
         if pane is not None and pane.size == size:
             return pane
         if pane is not None:
+            self.restore()
             pane.release()
         target = RenderTarget(self.ctx, size)
         target.color.filter = (moderngl.NEAREST, moderngl.NEAREST)
@@ -111,7 +121,7 @@ class Viewport:
         set_uniform(program, "u_exposure", float(exposure))
         set_uniform(program, "u_diff_scale", float(diff_scale))
         self.display_vao.render(moderngl.TRIANGLES, vertices=3)
-        self.ctx.screen.use()
+        self.restore()
         return pane.display
 
     # ------------------------------------------------------------ read back
@@ -121,7 +131,7 @@ class Viewport:
         x, y = pixel
         raw = pane.target.fbo.read(viewport=(x, pane.size[1] - 1 - y, 1, 1), components=3,
                                    dtype="f4")
-        self.ctx.screen.use()
+        self.restore()
         return np.frombuffer(raw, dtype=np.float32).astype(np.float64)
 
     def read_linear(self, key: str) -> np.ndarray:
@@ -146,10 +156,11 @@ class Viewport:
             tex = self.ctx.texture((w, h), 4, dtype="f1")
             tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
             self.images[key] = tex
-        tex.write(np.ascontiguousarray(rgba[::-1]).tobytes())
+        tex.write(rgba.tobytes())  # row 0 first: imgui's default uv puts it on top
         return tex
 
     def release(self) -> None:
+        self.restore()
         for pane in self.panes.values():
             pane.release()
         self.panes.clear()
@@ -161,3 +172,5 @@ class Viewport:
         self.display_program.release()
         self.lines_program.release()
         self.renderer.release()
+        (self.ctx.screen or self.ctx.detect_framebuffer(0)).use()
+        self._anchor.release()

@@ -1,0 +1,294 @@
+"""The viewer's logic without a window: probe vs GPU, jobs, undo, autosave, camera, CLI errors."""
+
+from __future__ import annotations
+
+import threading
+import time
+
+import numpy as np
+import pytest
+
+from app.cli import main
+from app.progress import Progress
+from app.scene import load_preset
+from app.scene.preset import scene_to_dict
+from app.ui.app import orbit, pan, zoom
+from app.ui.jobs import JobRunner, difference, iter_reference_raster
+from app.ui.probe import probe
+from app.ui.state import AppState, History, autosave_path, load_session, save_session
+
+# ---------------------------------------------------------------- command line
+
+
+def _one_error_line(capsys) -> str:
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    return err[0]
+
+
+def test_no_display_says_use_render_or_xvfb(monkeypatch, capsys):
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    assert main([]) == 2
+    line = _one_error_line(capsys)
+    assert "shadelab render" in line and "Xvfb" in line
+
+
+@pytest.mark.parametrize("argv, expected", [
+    (["view", "no-such-preset"], "unknown preset 'no-such-preset'"),
+    (["view", "cornell", "--probe", "1;2"], "--probe '1;2'"),
+    (["view", "cornell", "--window", "big"], "--size 'big'"),
+    (["view", "cornell", "--set", "materials.white.kd=7"], "materials.white.kd"),
+])
+def test_view_bad_input_is_one_line_exit_2(monkeypatch, capsys, argv, expected):
+    monkeypatch.setenv("DISPLAY", ":12345")  # never reached: the input fails first
+    assert main(argv) == 2
+    assert expected in _one_error_line(capsys)
+
+
+# ---------------------------------------------------------------- probe (numpy) vs GPU
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("preset", ["cornell", "sphere-shading"])
+@pytest.mark.parametrize("shading", ["flat", "gouraud", "phong"])
+@pytest.mark.parametrize("specular", ["phong", "blinn"])
+def test_probe_terms_match_the_gpu_pixel(gl_ctx, preset, shading, specular):
+    """The probe's reference sum equals what the GPU drew (rtol 1e-4, atol 1e-5)."""
+    from app.ui.viewport import Viewport
+
+    scene = load_preset(preset)
+    for m in scene.materials.values():  # give every surface a highlight to check
+        m.ks, m.n = max(m.ks, 0.3), 20.0
+    size = (48, 40)
+    vp = Viewport(gl_ctx)
+    try:
+        vp.draw_scene("main", scene, size, shading, specular)
+        image = vp.read_linear("main")
+        checked = 0
+        for y in range(2, size[1], 7):
+            for x in range(3, size[0], 9):
+                result = probe(scene, size, (x, y), shading, specular)
+                if result is None:
+                    continue
+                gpu = vp.read_pixel("main", (x, y))
+                np.testing.assert_allclose(gpu, image[y, x], rtol=0, atol=0)
+                np.testing.assert_allclose(gpu, result.reference, rtol=1e-4, atol=1e-5)
+                if shading == "phong":  # the listed terms add up to the pixel
+                    np.testing.assert_allclose(result.terms.total, result.reference, rtol=1e-12)
+                checked += 1
+        assert checked >= 12
+    finally:
+        vp.release()
+
+
+@pytest.mark.gl
+def test_display_pass_is_exposure_then_srgb_and_heat_map_of_equal_images_is_black(gl_ctx):
+    from app.shading.conventions import to_srgb8
+    from app.ui.viewport import Viewport
+
+    scene = load_preset("cornell")
+    vp = Viewport(gl_ctx)
+    try:
+        pane = vp.draw_scene("a", scene, (40, 32), "phong", "phong")
+        vp.present(pane, 2.0)
+        shown = vp.read_display("a").astype(int)
+        expected = to_srgb8(vp.read_linear("a"), 2.0).astype(int)
+        assert np.abs(shown - expected).max() <= 1
+        twin = vp.draw_scene("b", scene, (40, 32), "phong", "phong")
+        diff = vp.pane("diff", (40, 32))
+        vp.present(diff, 1.0, pane, twin, 0.05)
+        assert vp.read_display("diff").max() == 0
+        flat = vp.draw_scene("c", scene, (40, 32), "flat", "phong")
+        vp.present(diff, 1.0, pane, flat, 0.05)
+        assert vp.read_display("diff").max() > 100  # flat vs Phong differ somewhere
+    finally:
+        vp.release()
+
+
+@pytest.mark.gl
+def test_reference_raster_job_matches_the_gpu_image(gl_ctx):
+    from app.render.offscreen import render_image
+
+    scene = load_preset("cornell")
+    steps = list(iter_reference_raster(scene, (40, 30), rows_per_chunk=8))
+    assert [round(s.fraction, 3) for s in steps[:4]] == [0.267, 0.533, 0.8, 1.0]
+    gpu = render_image(scene, (40, 30), "phong", "phong")
+    err = difference(steps[-1].image, gpu)
+    assert err["max_abs"] < 1e-3 * float(gpu.max()), err
+
+
+# ---------------------------------------------------------------- probe math without GL
+
+
+def test_probe_of_the_floor_lists_the_lecture_terms():
+    """Cornell floor straight below the light: N = +y, f_att = 1/d^2, diffuse = Ip kd Od N.L/d^2."""
+    scene = load_preset("cornell")
+    size = (64, 64)
+    result = probe(scene, size, (32, 60), "phong", "phong")
+    assert result is not None and result.hit.mesh.material == "white"
+    np.testing.assert_allclose(result.normal, [0, 1, 0], atol=1e-12)
+    light = scene.lights[0]
+    d = np.linalg.norm(np.subtract(light.position, result.point))
+    term = result.terms.lights[0]
+    assert term.f_att == pytest.approx(1.0 / d**2, rel=1e-12)
+    n_dot_l = (light.position[1] - result.point[1]) / d
+    expected = np.asarray(light.Ip) * np.asarray(scene.materials["white"].Od) * n_dot_l / d**2
+    np.testing.assert_allclose(term.diffuse, expected, rtol=1e-12)
+    assert not bool(term.clamp_active)
+    assert probe(scene, size, (0, 0)) is None  # past the open front: background, no terms
+
+
+def test_probe_shows_the_attenuation_clamp():
+    scene = load_preset("cornell")
+    light = scene.lights[0]
+    light.attenuation, light.c1, light.c2, light.c3 = "lecture", 0.5, 0.0, 0.0
+    result = probe(scene, (32, 32), (16, 30))
+    assert bool(result.terms.lights[0].clamp_active) and result.terms.lights[0].f_att == 1.0
+
+
+# ---------------------------------------------------------------- camera
+
+
+def test_orbit_keeps_the_distance_zoom_scales_it_pan_moves_both():
+    scene = load_preset("cornell")
+    cam = scene.camera
+    dist = np.linalg.norm(np.subtract(cam.eye, cam.target))
+    orbit(cam, 40.0, -25.0)
+    assert np.linalg.norm(np.subtract(cam.eye, cam.target)) == pytest.approx(dist, rel=1e-12)
+    assert not np.allclose(cam.eye, (278.0, 273.0, -800.0))
+    zoom(cam, 2.0)
+    assert np.linalg.norm(np.subtract(cam.eye, cam.target)) == pytest.approx(dist * 0.81)
+    before = np.subtract(cam.eye, cam.target)
+    target = np.asarray(cam.target)
+    pan(cam, 10.0, 5.0, 500)
+    np.testing.assert_allclose(np.subtract(cam.eye, cam.target), before, atol=1e-9)
+    assert np.linalg.norm(np.asarray(cam.target) - target) > 0.0
+
+
+# ---------------------------------------------------------------- undo, files, autosave
+
+
+def test_history_undo_redo_and_a_new_edit_drops_the_redo_branch():
+    scene = load_preset("cornell")
+    history = History(scene)
+    scene.materials["white"].kd = 0.5
+    history.push(scene)
+    history.push(scene)  # unchanged: no new snapshot
+    scene.materials["white"].kd = 0.25
+    history.push(scene)
+    assert len(history.snapshots) == 3
+    assert history.undo().materials["white"].kd == 0.5
+    assert history.undo().materials["white"].kd == 1.0
+    assert history.undo() is None
+    assert history.redo().materials["white"].kd == 0.5
+    edited = history.redo()
+    edited.materials["red"].kd = 0.1
+    history.index = 1
+    history.push(edited)
+    assert not history.can_redo() and len(history.snapshots) == 3
+
+
+def test_open_broken_preset_keeps_the_scene_and_shows_the_error(tmp_path):
+    state = AppState.from_scene(load_preset("cornell"), "cornell")
+    state.scene.materials["white"].kd = 0.3
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[materials.white]\nkd = 'much'\n")
+    assert not state.open_preset(str(bad))
+    assert "bad.toml" in state.error and state.scene.materials["white"].kd == 0.3
+    mesh = tmp_path / "mesh.toml"
+    mesh.write_text('schema_version = 1\n[[objects]]\nshape = "mesh"\npath = "missing.obj"\n'
+                    'material = "m"\n[materials.m]\n')
+    assert not state.open_preset(str(mesh))
+    assert "missing.obj" in state.error and state.scene.name == "cornell"
+
+
+def test_save_as_round_trips_and_clears_the_unsaved_flag(tmp_path):
+    state = AppState.from_scene(load_preset("cornell"), "cornell")
+    state.scene.materials["white"].kd = 0.4
+    state.commit_edit()
+    assert state.dirty and state.title().endswith("*")
+    assert state.save_as(str(tmp_path / "mine"))
+    assert not state.dirty and not state.title().endswith("*")
+    again = load_preset(str(tmp_path / "mine.toml"))
+    assert scene_to_dict(again) == scene_to_dict(state.scene)
+    assert not state.save_as(str(tmp_path / "no" / "such" / "dir.toml"))
+    assert "cannot write" in state.error
+
+
+def test_autosave_honours_xdg_state_home_and_restores(tmp_path, monkeypatch):
+    monkeypatch.setenv("XDG_STATE_HOME", str(tmp_path / "xdg"))
+    assert autosave_path() == tmp_path / "xdg" / "shadelab" / "autosave.toml"
+    assert load_session() is None
+    scene = load_preset("cornell")
+    scene.lights[0].Ip = (1.0, 2.0, 3.0)
+    save_session(scene, "cornell")
+    restored, source = load_session()
+    assert source == "cornell" and restored.name == "cornell"
+    assert restored.base_dir == scene.base_dir
+    assert scene_to_dict(restored) == scene_to_dict(scene)
+
+
+# ---------------------------------------------------------------- the job runner
+
+
+def _slow_job(closed: threading.Event, steps: int = 200, pause: float = 0.01):
+    try:
+        for i in range(steps):
+            time.sleep(pause)
+            yield Progress(np.full((2, 2, 3), i, np.float32), (i + 1) / steps, f"step {i}")
+    finally:
+        closed.set()
+
+
+def test_job_runs_off_thread_and_cancel_closes_the_generator():
+    closed = threading.Event()
+    runner = JobRunner()
+    runner.start("slow", lambda: _slow_job(closed))
+    deadline = time.perf_counter() + 2.0
+    while runner.snapshot()[0] is None and time.perf_counter() < deadline:
+        time.sleep(0.005)
+    assert runner.running
+    runner.cancel(wait=True)
+    assert closed.is_set() and runner.cancelled and not runner.running
+    assert runner.snapshot()[0].fraction < 1.0
+    assert runner.elapsed < 1.5
+
+
+def test_job_runs_to_the_end_and_reports_errors():
+    closed = threading.Event()
+    runner = JobRunner()
+    runner.start("short", lambda: _slow_job(closed, steps=5, pause=0.0))
+    runner._thread.join(2.0)
+    assert runner.snapshot()[0].fraction == 1.0 and not runner.cancelled and not runner.error
+
+    def broken():
+        yield Progress(None, 0.1)
+        raise ValueError("bad patch count")
+
+    runner.start("broken", broken)
+    runner._thread.join(2.0)
+    assert runner.error == "ValueError: bad patch count" and not runner.running
+
+
+def test_available_jobs_lists_every_renderer_with_a_reason_when_missing():
+    from app.ui.jobs import available_jobs
+
+    kinds = available_jobs()
+    labels = [k.label for k in kinds]
+    assert labels[0].startswith("Reference raster") and kinds[0].make is not None
+    assert any(label.startswith("Whitted") for label in labels)
+    for kind in kinds:
+        assert (kind.make is None) == bool(kind.reason)
+
+
+def test_legend_is_burned_into_the_bottom_band():
+    from app.ui.legend import burn_legend, legend_lines
+
+    state = AppState.from_scene(load_preset("cornell"), "cornell")
+    image = np.full((200, 300, 3), 128, np.uint8)
+    out = burn_legend(image, state)
+    assert out.shape == image.shape
+    assert np.array_equal(out[:100], image[:100])
+    assert not np.array_equal(out[-30:], image[-30:])
+    assert "Phong shading" in legend_lines(state)[0].replace("phong shading", "Phong shading")
