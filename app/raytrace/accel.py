@@ -116,15 +116,18 @@ class EmbreeAccel:
         t = np.where(hit, out["tfar"].astype(np.float64), np.inf)
         return Hits(t, tri, out["u"].astype(np.float64), out["v"].astype(np.float64))
 
-    def occluded(self, origins: np.ndarray, dirs: np.ndarray, tmax: np.ndarray) -> np.ndarray:
+    def occluded(self, origins: np.ndarray, dirs: np.ndarray, tmax: np.ndarray,
+                 everything: bool = False) -> np.ndarray:
+        """True where a shadow caster (any triangle with ``everything``) lies at t < tmax."""
         n = len(origins)
-        if n == 0 or len(self._caster_ids) == 0:
+        target = self._all if everything else self._casters
+        if n == 0 or (self.geometry.count if everything else len(self._caster_ids)) == 0:
             return np.zeros(n, bool)
         o = np.ascontiguousarray(origins, dtype=np.float32)
         d = np.ascontiguousarray(dirs, dtype=np.float32)
         dists = np.ascontiguousarray(np.minimum(np.broadcast_to(tmax, (n,)), T_INF),
                                      dtype=np.float32)
-        return self._casters.run(o, d, dists=dists, query="OCCLUDED") != -1
+        return target.run(o, d, dists=dists, query="OCCLUDED") != -1
 
 
 def _misses(n: int) -> Hits:
@@ -156,12 +159,15 @@ class BvhAccel:
                                            np.ascontiguousarray(dirs, np.float64), limit)
         return Hits(np.where(tri >= 0, t, np.inf), tri, u, v)
 
-    def occluded(self, origins: np.ndarray, dirs: np.ndarray, tmax: np.ndarray) -> np.ndarray:
+    def occluded(self, origins: np.ndarray, dirs: np.ndarray, tmax: np.ndarray,
+                 everything: bool = False) -> np.ndarray:
+        """True where a shadow caster (any triangle with ``everything``) lies at t < tmax."""
         n = len(origins)
-        if n == 0 or len(self._caster_ids) == 0:
+        if n == 0 or (self.geometry.count if everything else len(self._caster_ids)) == 0:
             return np.zeros(n, bool)
         limit = np.minimum(np.broadcast_to(tmax, (n,)), T_INF).astype(np.float64)
-        return self._bvh.occluded(self._casters, np.ascontiguousarray(origins, np.float64),
+        tree = self._all if everything else self._casters
+        return self._bvh.occluded(tree, np.ascontiguousarray(origins, np.float64),
                                   np.ascontiguousarray(dirs, np.float64), limit)
 
 
