@@ -78,3 +78,29 @@ def test07_render_error_flag_bad_input(tmp_path, capsys, value):
     code = main(["render", "sphere-shading", "-o", str(tmp_path / "x.png"), "--error", value])
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1 and "--error" in err
+
+
+def test08_measured_raytrace_front():
+    pytest.importorskip("app.raytrace.whitted")
+    from app.scene.preset import load_preset
+    from app.studies.autoquality import front_from_rows
+    from app.studies.raytrace_study import COLUMNS, measure
+
+    rows = measure(load_preset("whitted"), (24, 24), (0, 1, 2, 4), (1, 4), (8, 16))
+    records = [dict(zip(COLUMNS, r, strict=True)) for r in rows]
+    points = front_from_rows(records, ("depth", "spp"), "time_ms")
+    best = pareto_front(points)[-1].error
+    for budget in (0.1, 2 * best):
+        choice = _check_choice(points, budget)
+        assert set(choice.point.setting) == {"depth", "spp"}
+
+
+def test09_raytrace_error_flag(tmp_path, capsys):
+    pytest.importorskip("app.raytrace.whitted")
+    out = tmp_path / "w.png"
+    assert main(["raytrace", "whitted", "-o", str(out), "--size", "24x18",
+                 "--error", "0.05"]) == 0
+    text = capsys.readouterr().out
+    assert "auto quality: depth" in text and out.is_file()
+    assert main(["raytrace", "whitted", "-o", str(out), "--error", "-1"]) == 2
+    assert capsys.readouterr().err.count("\n") == 1

@@ -110,3 +110,14 @@ def test08_shadow_study_agrees_with_rays_except_zpass_inside(gl_ctx):
         assert row["time_ms"] > 0 and row["oracle_ms"] > 0
     scenes = set(result.column("scene"))
     assert {"shadows", "fail-zpass-eye-inside", "fail-open-caster"} <= scenes
+
+
+def test09_raytrace_study_depth_and_samples_help():
+    pytest.importorskip("app.raytrace.whitted")
+    from app.studies.raytrace_study import run_raytrace
+
+    result = run_raytrace(quick=True)
+    err = {(r["depth"], r["spp"]): r["relmse"] for r in result.records()}
+    assert err[(0, 1)] > 2 * err[(2, 1)]          # mirror and glass need secondary rays
+    assert err[(4, 4)] < err[(4, 1)]              # more samples: edges converge
+    assert all(r["time_ms"] > 0 for r in result.records())

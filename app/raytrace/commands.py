@@ -24,6 +24,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="weight reflection/refraction by Fresnel's equations")
     p.add_argument("--backend", choices=BACKENDS, default="auto",
                    help="ray casting: embree (embreex) or the numba BVH")
+    p.add_argument("--error", type=float, metavar="BUDGET",
+                   help="auto quality: the cheapest depth and spp within this relative MSE "
+                        "(e.g. 0.01; see app.studies.autoquality)")
     p.set_defaults(run=run_raytrace)
 
     p = sub.add_parser("pathtrace", help="Monte Carlo path tracing (reference radiance)")
@@ -61,9 +64,19 @@ def run_raytrace(args: argparse.Namespace) -> int:
     if not scene.active_lights():
         raise ShadeLabError(f"{args.preset}: lights: the ray tracer needs at least one "
                             "enabled light")
+    if getattr(args, "error", None) is not None:
+        from app.studies.autoquality import check_budget
+
+        check_budget(args.error)
     check_outputs(args)
     from app.progress import run_to_end
     from app.raytrace.whitted import iter_raytrace
+
+    if getattr(args, "error", None) is not None:
+        from app.studies.raytrace_study import auto_raytrace
+
+        args.depth, args.spp, line = auto_raytrace(scene, size, args.error)
+        print(line)
 
     last = run_to_end(iter_raytrace(scene, size, args.depth, args.spp, args.fresnel,
                                     args.backend), desc="raytrace")

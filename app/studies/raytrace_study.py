@@ -1,0 +1,98 @@
+"""Whitted ray tracing: error against time over recursion depth and samples per pixel.
+
+The reference is the same scene traced much deeper with many more samples (another jitter
+seed); each setting's error is measured against it on the whole image. The ray-casting
+accelerator is built once, so times are tracing only.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import time
+from statistics import median
+
+import numpy as np
+
+from app.scene.model import Scene
+from app.studies import metrics
+from app.studies.result import StudyResult, StudySkipped
+
+COLUMNS = ["depth", "spp", "time_ms", "mae", "rmse", "relmse"]
+PRESET = "whitted"   # a mirror and a glass sphere over a checkerboard: depth matters
+
+
+def _require() -> None:
+    if importlib.util.find_spec("app.raytrace.whitted") is None:
+        raise StudySkipped("app.raytrace.whitted is not built yet")
+
+
+def trace(scene: Scene, size: tuple[int, int], depth: int, spp: int, ctx, seed: int = 0):
+    """The finished Whitted image (H, W, 3) float64 and its wall time in milliseconds."""
+    from app.raytrace.whitted import iter_raytrace
+
+    start = time.perf_counter()
+    steps = list(iter_raytrace(scene, size, depth, spp, seed=seed, ctx=ctx))
+    last = steps[-1]
+    return np.asarray(last.image, dtype=np.float64), (time.perf_counter() - start) * 1000.0
+
+
+def measure(scene: Scene, size: tuple[int, int], depths, spps, reference: tuple[int, int],
+            repeats: int = 1) -> list[list]:
+    """Rows of :data:`COLUMNS` for every (depth, spp) against a (depth, spp) reference."""
+    from app.raytrace.surface import TraceContext
+
+    ctx = TraceContext(scene)
+    ref, _ = trace(scene, size, reference[0], reference[1], ctx, seed=12345)
+    rows = []
+    for spp in spps:
+        for depth in depths:
+            times = []
+            for _ in range(repeats):
+                image, ms = trace(scene, size, depth, spp, ctx)
+                times.append(ms)
+            errors = metrics.all_metrics(image, ref)
+            rows.append([depth, spp, median(times), errors["mae"], errors["rmse"],
+                         errors["relmse"]])
+    return rows
+
+
+def run_raytrace(quick: bool = False) -> StudyResult:
+    """Error vs time of the Whitted tracer on cornell-spheres over depth and spp."""
+    _require()
+    from app.scene.preset import load_preset
+
+    scene = load_preset(PRESET)
+    if quick:
+        size, depths, spps, reference, repeats = (40, 40), (0, 1, 2, 4), (1, 4), (8, 16), 1
+    else:
+        size, depths, spps, reference, repeats = ((128, 128), (0, 1, 2, 3, 4, 6, 8),
+                                                  (1, 2, 4, 8, 16), (16, 64), 3)
+    rows = measure(scene, size, depths, spps, reference, repeats)
+    by_depth = StudyResult(
+        name="raytrace-depth", title="Ray tracing: error vs depth", columns=list(COLUMNS),
+        rows=rows, x="depth", y="relmse", group="spp", log_x=False)
+    return StudyResult(
+        name="raytrace", title=f"Whitted ({PRESET}, {size[0]}x{size[1]}): error vs time",
+        columns=list(COLUMNS), rows=rows, x="time_ms", y="relmse", group="spp", label="depth",
+        notes=[f"reference: depth {reference[0]}, {reference[1]} spp (other jitter seed)",
+               "series: samples per pixel; labels: recursion depth"],
+        extra={"depth": by_depth})
+
+
+def auto_raytrace(scene: Scene, size: tuple[int, int], budget: float,
+                  max_side: int = 48) -> tuple[int, int, str]:
+    """The cheapest (depth, spp) whose relative MSE meets ``budget``, measured on a small
+    probe of the scene itself; returns depth, spp and a report line."""
+    from app.studies.autoquality import check_budget, choose_setting, front_from_rows
+
+    _require()
+    budget = check_budget(budget)
+    scale = min(1.0, max_side / max(size))
+    probe = (max(8, round(size[0] * scale)), max(8, round(size[1] * scale)))
+    rows = measure(scene, probe, (0, 1, 2, 3, 4, 6, 8), (1, 2, 4, 8, 16), (16, 64))
+    records = [dict(zip(COLUMNS, row, strict=True)) for row in rows]
+    choice = choose_setting(front_from_rows(records, ("depth", "spp"), "time_ms"), budget)
+    depth, spp = int(choice.point.setting["depth"]), int(choice.point.setting["spp"])
+    verdict = "<=" if choice.met else "> (best reachable)"
+    return depth, spp, (f"auto quality: depth {depth}, spp {spp}: relMSE "
+                        f"{choice.point.error:.3g} {verdict} {budget:g}")
