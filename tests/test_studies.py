@@ -121,3 +121,24 @@ def test09_raytrace_study_depth_and_samples_help():
     assert err[(0, 1)] > 2 * err[(2, 1)]          # mirror and glass need secondary rays
     assert err[(4, 4)] < err[(4, 1)]              # more samples: edges converge
     assert all(r["time_ms"] > 0 for r in result.records())
+
+
+@pytest.mark.gl
+def test10_radiosity_study(gl_ctx):
+    pytest.importorskip("app.radiosity.solution")
+    from app.studies.radiosity_study import run_radiosity
+
+    result = run_radiosity(quick=True)
+    rows = result.records()
+    err = {(r["series"], r["label"]): r["relmse"] for r in rows}
+    assert err[("raycast", "25")] > 2 * err[("raycast", "100")]       # more patches, less error
+    assert err[("hemicube-resolution", "8")] > 2 * err[("hemicube-resolution", "32")]
+    assert err[("analytic", "100")] > 5 * err[("raycast", "100")]     # ignores the blocks
+    direct = err[("solver", "direct")]
+    for solver in ("jacobi", "gauss-seidel", "progressive"):
+        assert abs(err[("solver", solver)] - direct) < 0.2 * direct     # all converge
+    conv = result.extra["convergence"]
+    for solver in ("jacobi", "progressive"):
+        values = conv.column("residual", conv.series()[solver])
+        assert len(values) > 3 and all(b <= a * (1 + 1e-9) for a, b in
+                                       zip(values, values[1:], strict=False))
