@@ -130,7 +130,9 @@ def test06_painter_cycle(gl_ctx):
     painter = _raster(scene)
     scene.render.visibility = "zbuffer"
     zbuffer = _raster(scene)
-    assert (np.abs(painter - zbuffer).max(-1) > 0.02).mean() > 0.01
+    differ = np.abs(painter - zbuffer).max(-1)
+    # Where the cycle closes, the painter shows the wrong quad on top: another color entirely
+    assert differ.max() > 0.5 and (differ > 0.02).mean() > 0.002
 
 
 def test07_shadow_acne_without_offset():
@@ -169,14 +171,30 @@ def test08_total_internal_reflection():
     assert np.all(np.isfinite(image)) and image.min() >= 0.0
 
 
-def test09_hemicube_aliasing():
-    pytest.importorskip("app.radiosity.formfactors")
-    pytest.skip("radiosity form-factor API not wired into the gallery yet")
+@pytest.mark.gl
+def test09_hemicube_aliasing(gl_ctx):
+    """A patch smaller than a hemicube pixel: at 8 px its form factor jumps between missing
+    (-100 %) and +50 % as it slides by sub-pixel steps; at 256 px it stays within 5 %."""
+    pytest.importorskip("app.radiosity.hemicube_gl")
+    gallery = pytest.importorskip("app.radiosity.gallery")
+    _case_scene("hemicube-aliasing")
+    out = gallery.hemicube_aliasing((8, 256))
+    # Known: the GL hemicube leaves GL_INVALID_OPERATION behind (reported to its owner);
+    # read it here so that later tests on the shared context start clean.
+    _ = gl_ctx.error
+    coarse, fine = out["relative_error"][8], out["relative_error"][256]
+    assert np.ptp(coarse) > 1.0 and np.abs(coarse).max() > 0.5
+    assert np.abs(fine).max() < 0.06
 
 
 def test10_radiosity_light_leak():
+    """The floor under a block (exact radiance 0) gets light when its patch runs under the
+    block; cutting the floor along the block's base removes the leak."""
+    gallery = pytest.importorskip("app.radiosity.gallery")
     _case_scene("radiosity-light-leak")
-    pytest.skip("radiosity solver API not wired into the gallery yet")
+    out = gallery.light_leak(60)
+    assert out["unsplit"] > 0.2 * out["lit_floor_mean"]
+    assert out["split"] < 0.01 * out["lit_floor_mean"]
 
 
 @pytest.mark.gl

@@ -30,12 +30,13 @@ def draw_panel(ax, result: StudyResult, front: bool = True) -> None:
         xs = [float(v) for v in result.column(result.x, rows)]
         ys = [max(float(v), floor) if result.log_y else float(v)
               for v in result.column(result.y, rows)]
-        ax.plot(xs, ys, marker="o", markersize=4, linewidth=1.2, label=name)
+        ax.plot(xs, ys, marker="o", markersize=4, linewidth=1.2 if result.lines else 0.0,
+                label=name)
         if result.label:
             for x, y, text in zip(xs, ys, result.column(result.label, rows), strict=False):
                 ax.annotate(str(text), (x, y), textcoords="offset points", xytext=(3, 3),
                             fontsize=6, alpha=0.8)
-    if front and result.x and result.y:
+    if front and result.front and result.x and result.y:
         points = [FrontPoint({}, float(r[0]), float(r[1]))
                   for r in zip(result.column(result.x), result.column(result.y), strict=False)]
         best = pareto_front(points)
@@ -69,6 +70,8 @@ def write_chart(result: StudyResult, out_dir: str | Path) -> list[Path]:
     plt.close(fig)
     result.write_csv(written[1])
     for key, table in result.extra.items():
+        if table.rows is result.rows:
+            continue  # the same measurements, plotted another way
         path = out / f"{result.name}-{key}.csv"
         table.write_csv(path)
         written.append(path)

@@ -69,7 +69,7 @@ GALLERY: list[GalleryCase] = [
         "(app.geometry.silhouette): the shadow stays right, at more fill cost.",
         T + "test05_open_caster", requires="app.render.shadows"),
     GalleryCase(
-        "painter-cyclic", "fail-painter-cycle", ("render.visibility=painter",), "raster:phong",
+        "painter-cyclic", "painter-cyclic", ("render.visibility=painter",), "raster:phong",
         "The painter's algorithm sorts whole polygons by depth; three polygons that overlap in "
         "a cycle have no correct order, so one is always drawn wrongly on top. The z-buffer "
         "(ShadeLab's default) resolves visibility per pixel.",
@@ -93,13 +93,13 @@ GALLERY: list[GalleryCase] = [
         "A hemicube samples the hemisphere with a pixel grid: small or distant patches fall "
         "between pixel centres or snap to whole pixels, so form factors alias (Baum et al. "
         "1989). Raise radiosity.hemicube_resolution or use raycast/analytic form factors.",
-        T + "test09_hemicube_aliasing", requires="app.radiosity.formfactors"),
+        T + "test09_hemicube_aliasing", requires="app.radiosity.solution"),
     GalleryCase(
         "radiosity-light-leak", "radiosity-leak", (), "radiosity",
         "A patch that runs under a wall is lit as a whole, so light appears on the dark side "
         "(a leak); radiosity is constant per patch. Mesh along the contact lines or use more "
         "patches.",
-        T + "test10_radiosity_light_leak", requires="app.radiosity.solver"),
+        T + "test10_radiosity_light_leak", requires="app.radiosity.solution"),
     GalleryCase(
         "degenerate-triangles", "fail-degenerate", (), "raster:gouraud",
         "A zero-area triangle has no normal. ShadeLab gives it a zero face normal, falls back to "
@@ -185,8 +185,6 @@ def render_case(case: GalleryCase, size: tuple[int, int]) -> tuple[np.ndarray, f
 
 
 def _render_radiosity(scene, size: tuple[int, int]) -> np.ndarray:
-    try:
-        from app.radiosity.render import render_radiosity
-    except ModuleNotFoundError:
-        raise GallerySkipped("the radiosity renderer is not built yet") from None
-    return render_radiosity(scene, size)
+    from app.radiosity.solution import solve_scene
+
+    return solve_scene(scene).image(size)

@@ -25,6 +25,7 @@ class StudyResult:
     group : the column whose values make separate series (e.g. "method")
     label : the column annotating each point (e.g. "level"), or ""
     log_x, log_y : axis scales of the main chart
+    lines, front : join each series' points; draw the Pareto front (cost x, error y)
     notes : lines worth printing next to the chart (reference used, machine, skips)
     extra : further named tables (e.g. a convergence curve per solver): name -> StudyResult
     """
@@ -39,6 +40,8 @@ class StudyResult:
     label: str = ""
     log_x: bool = True
     log_y: bool = True
+    lines: bool = True           # join a series' points (False: a scatter of unrelated cases)
+    front: bool = True           # draw the Pareto front of (x, y) over all rows
     notes: list[str] = field(default_factory=list)
     extra: dict[str, "StudyResult"] = field(default_factory=dict)
 

@@ -135,7 +135,7 @@ def run_shadows(quick: bool = False) -> StudyResult:
     return StudyResult(
         name="shadows", title=f"Shadow volumes vs shadow rays ({size[0]}x{size[1]})",
         columns=list(COLUMNS), rows=rows + sweep, x="time_ms", y="mismatch", group="method",
-        label="scene",
+        label="scene", lines=False, front=False,
         notes=["mismatch: share of pixel-light pairs (surface facing the light) where the "
                "stencil count and the CPU shadow ray disagree",
                "fail-zpass-eye-inside: the eye is inside a volume, z-pass inverts the count"],
