@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from app.raytrace import kernels
 from app.raytrace.accel import T_INF, Hits, SceneGeometry, build_accel, scene_geometry
 from app.scene.model import Material, Scene
 from app.shading.reference import light_vectors, shade
@@ -53,11 +54,17 @@ class TraceContext:
     backend : "auto" (Embree where embreex imports), "embree" or "bvh"
     shadows : False makes every S_i = 1 (no shadow rays), as the raster without volumes
     offset : ray origin offset as a fraction of the scene diagonal (default: the preset's)
+    local : "numba" (the kernels of :mod:`app.raytrace.kernels`, fast) or "numpy" (calls
+        :func:`app.shading.reference.shade` itself); the two agree to 1e-9 (tested)
     """
 
     def __init__(self, scene: Scene, backend: str = "auto", shadows: bool = True,
-                 offset: float | None = None, geometry: SceneGeometry | None = None):
+                 offset: float | None = None, geometry: SceneGeometry | None = None,
+                 local: str = "numba"):
+        if local not in ("numba", "numpy"):
+            raise ValueError(f"unknown local model implementation {local!r}")
         self.scene = scene
+        self.kernels = local == "numba"
         self.geometry = scene_geometry(scene) if geometry is None else geometry
         self.accel = build_accel(self.geometry, backend)
         self.lights = scene.active_lights()
@@ -72,12 +79,25 @@ class TraceContext:
         self.background = np.asarray(scene.render.background, dtype=np.float64)
         self.specular = scene.render.specular
         self.shadow_rays = 0  # counter, for rays/s figures
+        self.material_table = kernels.material_table(self.materials)
+        self.light_table = kernels.light_table(self.lights)
+        self.Ia = np.asarray(scene.Ia, dtype=np.float64)
+        mats = self.materials
+        self.kr = np.array([m.mirror for m in mats], dtype=np.float64)
+        self.kt = np.array([m.kt for m in mats], dtype=np.float64)
+        self.ior = np.array([m.ior for m in mats], dtype=np.float64)
+        self.tint = np.array([m.Ot if m.transparency == "filtered" else (1.0, 1.0, 1.0)
+                              for m in mats], dtype=np.float64).reshape(-1, 3)
 
     # ------------------------------------------------------------ hits
     def surface(self, origins: np.ndarray, dirs: np.ndarray, hits: Hits) -> Surface:
         """The surface at each hit (call with hits that all hit something)."""
         g = self.geometry
         tri = hits.tri
+        if self.kernels:
+            return Surface(*kernels.surface_frame(
+                np.ascontiguousarray(origins), np.ascontiguousarray(dirs), hits.t, tri,
+                hits.u, hits.v, g.corner_normals, g.face_normals, g.object_index))
         position = origins + hits.t[:, None] * dirs
         w0 = 1.0 - hits.u - hits.v
         corner = g.corner_normals[tri]
@@ -97,6 +117,9 @@ class TraceContext:
         """S_i per light for the points ``select`` (all by default): 1 lit, 0 in shadow."""
         pos = surf.position if select is None else surf.position[select]
         ng = surf.geo_normal if select is None else surf.geo_normal[select]
+        if self.kernels:
+            return self._shadow_factors_kernel(np.ascontiguousarray(pos),
+                                               np.ascontiguousarray(ng))
         factors = []
         for light in self.lights:
             to_light, distance = light_vectors(light, pos)
@@ -116,6 +139,23 @@ class TraceContext:
             factors.append(s)
         return factors
 
+    def _shadow_factors_kernel(self, pos: np.ndarray, ng: np.ndarray) -> list[np.ndarray]:
+        factors = []
+        for k in range(len(self.lights)):
+            if not self.shadows:
+                factors.append(np.ones(len(pos)))
+                continue
+            origin, dirs, tmax, facing = kernels.shadow_rays(pos, ng, self.light_table, k,
+                                                             self.eps, T_INF)
+            s = np.zeros(len(pos))
+            idx = np.flatnonzero(facing)
+            if len(idx):
+                blocked = self.accel.occluded(origin[idx], dirs[idx], tmax[idx])
+                s[idx] = np.where(blocked, 0.0, 1.0)
+                self.shadow_rays += len(idx)
+            factors.append(s)
+        return factors
+
     def local(self, surf: Surface, dirs: np.ndarray, shadow: list | None = None) -> np.ndarray:
         """The lecture's local model at each hit (reference.shade, with shadow-ray S_i)."""
         out = np.zeros((len(surf.position), 3))
@@ -123,6 +163,12 @@ class TraceContext:
             return out
         shadow = self.shadow_factors(surf) if shadow is None else shadow
         mat = self.material_ids(surf)
+        if self.kernels:
+            s = (np.stack(shadow) if shadow else np.zeros((0, len(out))))
+            return kernels.local_shade(surf.position, surf.normal,
+                                       np.ascontiguousarray(-dirs), mat, self.material_table,
+                                       self.light_table, self.Ia, self.specular == "blinn",
+                                       np.ascontiguousarray(s, dtype=np.float64))
         for m in np.unique(mat):
             idx = np.flatnonzero(mat == m)
             pos = surf.position[idx]
@@ -142,11 +188,7 @@ class TraceContext:
         """
         n = len(dirs)
         mat = self.material_ids(surf)
-        kr = np.array([m.mirror for m in self.materials])[mat]
-        kt = np.array([m.kt for m in self.materials])[mat]
-        ior = np.array([m.ior for m in self.materials])[mat]
-        tint = np.array([m.Ot if m.transparency == "filtered" else (1.0, 1.0, 1.0)
-                         for m in self.materials], dtype=np.float64).reshape(-1, 3)[mat]
+        kr, kt, ior, tint = self.kr[mat], self.kt[mat], self.ior[mat], self.tint[mat]
         refl_dir, refr_dir, tir, f = reflect_refract(dirs, surf.normal, surf.entering, ior)
         if fresnel:
             refl_scalar = kr + kt * f
@@ -157,6 +199,25 @@ class TraceContext:
         refl_w = np.repeat(refl_scalar[:, None], 3, axis=1)
         refr_w = refr_scalar[:, None] * tint
         return refl_dir, refl_w.reshape(n, 3), refr_dir, refr_w.reshape(n, 3)
+
+    def spawn(self, surf: Surface, dirs: np.ndarray, weight: np.ndarray, pixel: np.ndarray,
+              fresnel: bool, min_weight: float):
+        """The next generation of rays (origins, dirs, weights, pixels) above ``min_weight``."""
+        mat = self.material_ids(surf)
+        if self.kernels:
+            return kernels.spawn_secondary(surf.position, surf.normal, surf.geo_normal,
+                                           surf.entering, np.ascontiguousarray(dirs), mat,
+                                           weight, pixel, self.kr, self.kt, self.ior,
+                                           self.tint, fresnel, min_weight, self.eps)
+        refl_dir, refl_w, refr_dir, refr_w = self.secondary(surf, dirs, fresnel)
+        refl_w, refr_w = weight * refl_w, weight * refr_w
+        keep_r = np.flatnonzero(refl_w.max(axis=1) >= max(min_weight, 1e-12))
+        keep_t = np.flatnonzero(refr_w.max(axis=1) >= max(min_weight, 1e-12))
+        origins = np.concatenate([self.offset_origin(surf, keep_r, True),
+                                  self.offset_origin(surf, keep_t, False)])
+        return (origins, np.concatenate([refl_dir[keep_r], refr_dir[keep_t]]),
+                np.concatenate([refl_w[keep_r], refr_w[keep_t]]),
+                np.concatenate([pixel[keep_r], pixel[keep_t]]))
 
     def offset_origin(self, surf: Surface, idx: np.ndarray, outward: bool) -> np.ndarray:
         """Origins moved off the surface by eps, to the incoming side (or through it)."""

@@ -63,17 +63,19 @@ def check_settings(depth: int, spp: int, size: tuple[int, int]) -> None:
 class WavefrontStats:
     """Counters for the figures a render reports."""
 
-    def __init__(self):
+    def __init__(self, shadow_start: int = 0):
+        self.shadow_start = shadow_start  # the context's shadow-ray counter at the start
         self.primary = 0
         self.primary_hits = 0
         self.secondary = 0
         self.depth_reached = 0
 
     def as_dict(self, ctx: TraceContext, elapsed: float) -> dict:
-        total = self.primary + self.secondary + ctx.shadow_rays
+        shadow = ctx.shadow_rays - self.shadow_start
+        total = self.primary + self.secondary + shadow
         return {"primary_rays": self.primary, "primary_hits": self.primary_hits,
                 "secondary_rays": self.secondary,
-                "shadow_rays": ctx.shadow_rays, "rays": total,
+                "shadow_rays": shadow, "rays": total,
                 "depth_reached": self.depth_reached, "seconds": elapsed,
                 "rays_per_s": total / elapsed if elapsed > 0 else 0.0,
                 "backend": ctx.accel.name}
@@ -113,15 +115,7 @@ def trace_batch(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarray, depth:
         if generation == depth:
             break
         # Spawn the reflected and refracted generation
-        refl_dir, refl_w, refr_dir, refr_w = ctx.secondary(surf, d, fresnel)
-        refl_w, refr_w = w * refl_w, w * refr_w
-        keep_r = np.flatnonzero(refl_w.max(axis=1) >= max(min_weight, 1e-12))
-        keep_t = np.flatnonzero(refr_w.max(axis=1) >= max(min_weight, 1e-12))
-        origins = np.concatenate([ctx.offset_origin(surf, keep_r, True),
-                                  ctx.offset_origin(surf, keep_t, False)])
-        dirs = np.concatenate([refl_dir[keep_r], refr_dir[keep_t]])
-        weight = np.concatenate([refl_w[keep_r], refr_w[keep_t]])
-        pixel = np.concatenate([px[keep_r], px[keep_t]])
+        origins, dirs, weight, pixel = ctx.spawn(surf, d, w, px, fresnel, min_weight)
     return out
 
 
@@ -158,10 +152,11 @@ def iter_raytrace(scene: Scene, size: tuple[int, int], depth: int | None = None,
     check_settings(depth, spp, size)
     width, height = size
     ctx = TraceContext(scene, backend, shadows) if ctx is None else ctx
-    stats = WavefrontStats()
+    stats = WavefrontStats(ctx.shadow_rays)
     rng = np.random.default_rng(seed)
     total = np.zeros((height * width, 3))
     count = np.zeros(height * width)
+    image = np.zeros((height, width, 3), np.float32)
     rows = max(1, TILE_RAYS // width)
     tiles = [(r, min(r + rows, height)) for r in range(0, height, rows)]
     start = time.perf_counter()
@@ -171,11 +166,12 @@ def iter_raytrace(scene: Scene, size: tuple[int, int], depth: int | None = None,
         for t, (r0, r1) in enumerate(tiles):
             o = origins[r0:r1].reshape(-1, 3)
             d = dirs[r0:r1].reshape(-1, 3)
-            total[r0 * width:r1 * width] += trace_batch(ctx, o, d, depth, fresnel, stats)
-            count[r0 * width:r1 * width] += 1
+            rows_done = slice(r0 * width, r1 * width)
+            total[rows_done] += trace_batch(ctx, o, d, depth, fresnel, stats)
+            count[rows_done] += 1
+            image[r0:r1] = (total[rows_done] / count[rows_done, None]).reshape(r1 - r0, width, 3)
             done = (sample * len(tiles) + t + 1) / (spp * len(tiles))
-            image = (total / np.maximum(count, 1)[:, None]).reshape(height, width, 3)
-            yield Progress(image.astype(np.float32), done,
+            yield Progress(image.copy(), done,
                            f"pass {sample + 1}/{spp}, rows {r1}/{height}",
                            stats.as_dict(ctx, time.perf_counter() - start))
 
