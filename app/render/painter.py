@@ -59,19 +59,23 @@ def draw_sorted(renderer, scene, gpu_meshes, shading: str, sorted_soup: SortedSo
     if not sorted_soup.runs:
         return
     ctx = renderer.ctx
-    program = renderer.programs[shading]
     vbo = ctx.buffer(sorted_soup.soup.tobytes())
-    layout = [a if a in program else None for a in VERTEX_ATTRIBUTES]
-    vao = ctx.vertex_array(program, [(vbo, _padded_format(layout), *[a for a in layout if a])])
+    vaos: dict[str, moderngl.VertexArray] = {}
     try:
         for position, first, count in sorted_soup.runs:
-            material = scene.materials[gpu_meshes[position].mesh.material]
-            renderer.set_material_uniforms(program, material)
+            name = gpu_meshes[position].mesh.material
+            program_name = renderer.use_material(scene, name, shading)
+            if program_name not in vaos:
+                program = renderer.programs[program_name]
+                layout = [a if a in program else None for a in VERTEX_ATTRIBUTES]
+                vaos[program_name] = ctx.vertex_array(
+                    program, [(vbo, _padded_format(layout), *[a for a in layout if a])])
             if before_run is not None:
-                before_run(material)
-            vao.render(moderngl.TRIANGLES, vertices=3 * count, first=3 * first)
+                before_run(scene.materials[name])
+            vaos[program_name].render(moderngl.TRIANGLES, vertices=3 * count, first=3 * first)
     finally:
-        vao.release()
+        for vao in vaos.values():
+            vao.release()
         vbo.release()
 
 

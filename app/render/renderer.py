@@ -15,10 +15,14 @@ import numpy as np
 from app.geometry.mesh import MeshData, geometry_key, object_mesh, scene_bounds
 from app.gl.programs import load_program, set_uniform, set_uniform_array
 from app.gl.target import RenderTarget
+from app.render.textures import TextureCache, has_surface_detail
 from app.scene.camera import far_plane, gl_matrix, projection_matrix, view_matrix
 from app.scene.model import MAX_LIGHTS, Light, Material, Scene
 
 SHADING_PROGRAMS = ("flat", "gouraud", "phong")
+# Variants with texture-mapped Od and bump maps (a geometry shader adds the tangents); only
+# materials with a texture or a bump use them, so every other material keeps its output.
+TEXTURED_PROGRAMS = {name: f"{name}_tex" for name in SHADING_PROGRAMS}
 LIGHT_KIND_CODES = {"point": 0, "directional": 1, "spot": 2}
 ATTENUATION_CODES = {"none": 0, "inverse_square": 1, "lecture": 2}
 
@@ -77,6 +81,8 @@ class Renderer:
     def __init__(self, ctx: moderngl.Context):
         self.ctx = ctx
         self.programs = {name: load_program(ctx, name) for name in SHADING_PROGRAMS}
+        self.programs.update({tex: load_program(ctx, tex) for tex in TEXTURED_PROGRAMS.values()})
+        self.textures = TextureCache(ctx)
         self._gpu: dict[int, GpuMesh] = {}
         self._shadows = None  # app.render.shadows.ShadowVolumes, made on first use
 
@@ -108,6 +114,24 @@ class Renderer:
         return GpuMesh(key, mesh, vbo, vaos)
 
     # ------------------------------------------------------------ uniforms
+    def variants(self, shading: str) -> list[moderngl.Program]:
+        """The shading mode's program and its surface-detail variant."""
+        return [self.programs[shading], self.programs[TEXTURED_PROGRAMS[shading]]]
+
+    def program_for(self, shading: str, material: Material) -> str:
+        """Name of the program that draws ``material`` in ``shading`` mode."""
+        return TEXTURED_PROGRAMS[shading] if has_surface_detail(material) else shading
+
+    def use_material(self, scene: Scene, name: str, shading: str) -> str:
+        """Set one material's uniforms (and textures) on its program; returns the program name."""
+        material = scene.materials[name]
+        program_name = self.program_for(shading, material)
+        program = self.programs[program_name]
+        self.set_material_uniforms(program, material)
+        if program_name != shading:
+            self.textures.bind(program, name, material, scene.base_dir)
+        return program_name
+
     def set_frame_uniforms(self, program: moderngl.Program, scene: Scene, view: View,
                            specular: str) -> None:
         set_uniform(program, "u_clip_from_world", gl_matrix(view.clip_from_world))
@@ -139,24 +163,25 @@ class Renderer:
         view = make_view(scene, target.size, [g.mesh for g in gpu_meshes], infinite_far=shadowed)
         opaque = [g for g in gpu_meshes if not is_transparent(scene.materials[g.mesh.material])]
         clear = [g for g in gpu_meshes if is_transparent(scene.materials[g.mesh.material])]
-        program = self.programs[shading]
         # --- PASS 1: clear color, depth and stencil
         target.clear(settings.background)
         if painter:
             # --- PASS 2 (list priority): every triangle back to front, no depth test
             from app.render.painter import draw_painter
 
-            self.set_frame_uniforms(program, scene, view, specular)
-            set_uniform(program, "u_ambient_on", 1.0)
+            for variant in self.variants(shading):
+                self.set_frame_uniforms(variant, scene, view, specular)
+                set_uniform(variant, "u_ambient_on", 1.0)
             draw_painter(self, scene, gpu_meshes, shading, view)
             return view
         # --- PASS 2: opaque surfaces, ambient + every light in one pass (S_i = 1);
         #     with shadow volumes: ambient + emission only (the lights come in pass 3)
         self.ctx.enable_only(moderngl.DEPTH_TEST)
-        self.set_frame_uniforms(program, scene, view, specular)
-        if shadowed:
-            write_light_uniforms(program, [])
-        set_uniform(program, "u_ambient_on", 1.0)
+        for variant in self.variants(shading):
+            self.set_frame_uniforms(variant, scene, view, specular)
+            if shadowed:
+                write_light_uniforms(variant, [])
+            set_uniform(variant, "u_ambient_on", 1.0)
         self.draw_objects(scene, opaque, shading)
         # --- PASS 3: per light, a stencil count of its shadow volumes (z-fail or z-pass),
         #     then that light alone added where the count is 0 (S_i = 1), nowhere else
@@ -167,8 +192,9 @@ class Renderer:
         if clear:
             from app.render.transparency import draw_transparent
 
-            self.set_frame_uniforms(program, scene, view, specular)
-            set_uniform(program, "u_ambient_on", 1.0)
+            for variant in self.variants(shading):
+                self.set_frame_uniforms(variant, scene, view, specular)
+                set_uniform(variant, "u_ambient_on", 1.0)
             draw_transparent(self, scene, clear, shading, view)
         # --- PASS 5: teaching overlays: stencil heat map, translucent volumes, silhouettes
         if shadowed and (settings.stencil_heatmap or settings.show_volumes
@@ -190,8 +216,8 @@ class Renderer:
                        opaque, lights: list[Light], shading: str) -> None:
         shadows = self.shadow_volumes
         shadows.drop_lights_from(len(lights))
-        program = self.programs[shading]
-        set_uniform(program, "u_ambient_on", 0.0)
+        for variant in self.variants(shading):
+            set_uniform(variant, "u_ambient_on", 0.0)
         for index, light in enumerate(lights):
             volumes = shadows.volumes(scene, gpu_meshes, index, light)
             shadows.count(target, view, volumes, scene.render.shadow_method)
@@ -199,14 +225,16 @@ class Renderer:
             self.ctx.blend_func = moderngl.ONE, moderngl.ONE
             self.ctx.depth_func = "<="
             shadows.lit_where_zero()
-            write_light_uniforms(program, [light])
+            for variant in self.variants(shading):
+                write_light_uniforms(variant, [light])
             self.draw_objects(scene, opaque, shading)
         shadows.stencil_off()
         self.ctx.depth_func = "<"
         target.fbo.depth_mask = True
         target.fbo.use()
-        write_light_uniforms(program, lights)
-        set_uniform(program, "u_ambient_on", 1.0)
+        for variant in self.variants(shading):
+            write_light_uniforms(variant, lights)
+            set_uniform(variant, "u_ambient_on", 1.0)
 
     def _shadow_overlays(self, scene: Scene, target: RenderTarget, view: View, gpu_meshes,
                          lights: list[Light]) -> None:
@@ -227,10 +255,9 @@ class Renderer:
         target.fbo.use()
 
     def draw_objects(self, scene: Scene, gpu_meshes: list[GpuMesh], shading: str) -> None:
-        program = self.programs[shading]
         for gpu in gpu_meshes:
-            self.set_material_uniforms(program, scene.materials[gpu.mesh.material])
-            gpu.vaos[shading].render(moderngl.TRIANGLES)
+            program_name = self.use_material(scene, gpu.mesh.material, shading)
+            gpu.vaos[program_name].render(moderngl.TRIANGLES)
 
     def release(self) -> None:
         for gpu in self._gpu.values():
@@ -241,6 +268,7 @@ class Renderer:
         if self._shadows is not None:
             self._shadows.release()
             self._shadows = None
+        self.textures.release()
 
 
 def is_transparent(material: Material) -> bool:
