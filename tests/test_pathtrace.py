@@ -34,6 +34,15 @@ def test_furnace_converges_to_le_over_one_minus_rho(rho, spread):
     assert np.percentile(np.abs(ratio - 1.0), 99) < spread
 
 
+def test_numpy_reference_path_agrees_on_the_furnace():
+    """The numpy implementation (the readable one) of the same estimator: within 2 %."""
+    rho, le = np.array([0.6, 0.5, 0.4]), np.array([1.0, 1.0, 1.0])
+    scene = _furnace(tuple(rho), tuple(le))
+    last = list(iter_pathtrace(scene, (16, 16), 16, seed=4, local="numpy"))[-1]
+    ratio = last.image.reshape(-1, 3) * (1.0 - rho) / le
+    np.testing.assert_allclose(ratio.mean(axis=0), 1.0, atol=0.02)
+
+
 def _corner_factor(x: float, y: float) -> float:
     """Point to a parallel rectangle x by y at unit height, the point under a corner.
 

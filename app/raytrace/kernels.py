@@ -1,5 +1,6 @@
-"""numba mirrors of the per-hit work, for speed: the surface frame at hits, shadow-ray setup
-and the lecture's local model.
+"""numba mirrors of the per-hit work, for speed: the surface frame at hits, shadow-ray setup,
+the lecture's local model, the spawning of Whitted's secondary rays and one path-tracer
+vertex (emission with MIS, next-event set-up, lobe choice, Russian roulette).
 
 :func:`local_shade` mirrors :func:`app.shading.reference.shade` term by term (same guards:
 EPS = 1e-12, pow only where the cosine is positive, f_att = 1 at infinite distance);
@@ -253,3 +254,149 @@ def spawn_secondary(position, normal, geo, entering, dirs, mat, weight, pixel, k
             out_p[count] = pixel[i]
             count += 1
     return out_o[:count], out_d[:count], out_w[:count], out_p[:count]
+
+
+@nb.njit(cache=True)
+def add_rows(out, pixel, value, mask):
+    """out[pixel[i]] += value[i] where mask[i] (serial: pixels repeat)."""
+    for i in range(len(pixel)):
+        if mask[i]:
+            for c in range(3):
+                out[pixel[i], c] += value[i, c]
+
+
+@nb.njit(cache=True)
+def path_vertex(out, pixel, beta, bsdf_pdf, position, normal, geo, entering, dirs, t, mat,
+                rho, kr, kt, ior, emission, em_cdf, em_p0, em_e1, em_e2, em_normal, em_le,
+                em_area, eps, rnd, roulette):
+    """One path vertex per path: emission (MIS-weighted), next-event set-up, lobe choice.
+
+    Mirrors ``PathTracer`` (see :mod:`app.raytrace.pathtrace` for the estimator). ``rnd``
+    holds 7 uniforms per path: emitter, 2 barycentrics, lobe, 2 direction, roulette.
+    Returns the shadow rays of next-event estimation (origins, dirs, tmax, candidate flag,
+    unoccluded contribution) and the continued paths (origins, dirs, beta, pdf, alive).
+    """
+    n = len(pixel)
+    nee_o = np.empty((n, 3))
+    nee_d = np.empty((n, 3))
+    nee_t = np.empty(n)
+    nee_ok = np.zeros(n, np.bool_)
+    nee_val = np.zeros((n, 3))
+    new_o = np.empty((n, 3))
+    new_d = np.empty((n, 3))
+    new_beta = np.empty((n, 3))
+    new_pdf = np.zeros(n)
+    alive = np.zeros(n, np.bool_)
+    n_em = len(em_cdf)
+    for i in range(n):
+        m = mat[i]
+        px, py, pz = position[i, 0], position[i, 1], position[i, 2]
+        nx, ny, nz = normal[i, 0], normal[i, 1], normal[i, 2]
+        gx, gy, gz = geo[i, 0], geo[i, 1], geo[i, 2]
+        dx, dy, dz = dirs[i, 0], dirs[i, 1], dirs[i, 2]
+        # Emission, MIS-weighted after a diffuse bounce
+        le_max = max(emission[m, 0], max(emission[m, 1], emission[m, 2]))
+        if le_max > 0.0:
+            w = 1.0
+            if bsdf_pdf[i] > 0.0:
+                cos_y = abs(gx * dx + gy * dy + gz * dz)
+                light_pdf = t[i] * t[i] / max(cos_y * em_area, 1e-300)
+                w = bsdf_pdf[i] / (bsdf_pdf[i] + light_pdf)
+            for c in range(3):
+                out[pixel[i], c] += beta[i, c] * emission[m, c] * w
+        p_d = (rho[m, 0] + rho[m, 1] + rho[m, 2]) / 3.0
+        total = p_d + kr[m] + kt[m]
+        prob_d = p_d / total if total > 0.0 else 0.0
+        # Next-event estimation: one point on the emitters, by area
+        if n_em > 0 and p_d > 0.0:
+            k = np.searchsorted(em_cdf, rnd[i, 0], side="right")
+            k = min(k, n_em - 1)
+            s = math.sqrt(rnd[i, 1])
+            a, b = s * (1.0 - rnd[i, 2]), s * rnd[i, 2]
+            qx = em_p0[k, 0] + a * em_e1[k, 0] + b * em_e2[k, 0] - px
+            qy = em_p0[k, 1] + a * em_e1[k, 1] + b * em_e2[k, 1] - py
+            qz = em_p0[k, 2] + a * em_e1[k, 2] + b * em_e2[k, 2] - pz
+            dist = math.sqrt(qx * qx + qy * qy + qz * qz)
+            if dist > 2.0 * eps:
+                wx, wy, wz = qx / dist, qy / dist, qz / dist
+                cos_x = nx * wx + ny * wy + nz * wz
+                cos_y = abs(em_normal[k, 0] * wx + em_normal[k, 1] * wy + em_normal[k, 2] * wz)
+                if cos_x > 0.0 and gx * wx + gy * wy + gz * wz > 0.0:
+                    light_pdf = dist * dist / max(cos_y * em_area, 1e-300)
+                    scale = cos_x / (light_pdf + prob_d * cos_x / math.pi) / math.pi
+                    nee_ok[i] = True
+                    nee_o[i, 0] = px + eps * gx
+                    nee_o[i, 1] = py + eps * gy
+                    nee_o[i, 2] = pz + eps * gz
+                    nee_d[i, 0], nee_d[i, 1], nee_d[i, 2] = wx, wy, wz
+                    nee_t[i] = dist * (1.0 - 1e-4) - 2.0 * eps
+                    for c in range(3):
+                        nee_val[i, c] = beta[i, c] * rho[m, c] * em_le[k, c] * scale
+        if total <= 0.0:
+            continue
+        # Pick a lobe
+        u = rnd[i, 3] * total
+        side = 1.0
+        if u < p_d:  # diffuse: cosine-weighted about the shading normal, weight rho / P
+            r = math.sqrt(rnd[i, 4])
+            phi = 2.0 * math.pi * rnd[i, 5]
+            lx, ly, lz = r * math.cos(phi), r * math.sin(phi), math.sqrt(max(1.0 - rnd[i, 4], 0.0))
+            sign = 1.0 if nz >= 0.0 else -1.0
+            aa = -1.0 / (sign + nz)
+            bb = nx * ny * aa
+            tx, ty, tz = 1.0 + sign * nx * nx * aa, sign * bb, -sign * nx
+            bx, by, bz = bb, sign + ny * ny * aa, -ny
+            ox = lx * tx + ly * bx + lz * nx
+            oy = lx * ty + ly * by + lz * ny
+            oz = lx * tz + ly * bz + lz * nz
+            if ox * gx + oy * gy + oz * gz <= 0.0:
+                continue
+            prob = prob_d
+            for c in range(3):
+                new_beta[i, c] = beta[i, c] * rho[m, c] / prob
+            new_pdf[i] = prob * lz / math.pi
+        else:
+            cos_i = min(max(-(dx * nx + dy * ny + dz * nz), 0.0), 1.0)
+            rx, ry, rz = dx + 2.0 * cos_i * nx, dy + 2.0 * cos_i * ny, dz + 2.0 * cos_i * nz
+            rl = math.sqrt(rx * rx + ry * ry + rz * rz)
+            ox, oy, oz = rx / rl, ry / rl, rz / rl
+            if u < p_d + kr[m]:  # mirror
+                prob = kr[m] / total
+                weight = kr[m]
+            else:  # glass: Fresnel picks reflection or refraction
+                prob = kt[m] / total
+                weight = kt[m]
+                if entering[i]:
+                    n1, n2 = 1.0, ior[m]
+                else:
+                    n1, n2 = ior[m], 1.0
+                eta = n1 / n2
+                kk = 1.0 - eta * eta * (1.0 - cos_i * cos_i)
+                f = 1.0
+                cos_t = 0.0
+                if kk >= 0.0:
+                    cos_t = math.sqrt(kk)
+                    rs = (n1 * cos_i - n2 * cos_t) / max(n1 * cos_i + n2 * cos_t, 1e-300)
+                    rp = (n2 * cos_i - n1 * cos_t) / max(n2 * cos_i + n1 * cos_t, 1e-300)
+                    f = 0.5 * (rs * rs + rp * rp)
+                if rnd[i, 4] >= f:
+                    aa = eta * cos_i - cos_t
+                    tx, ty, tz = eta * dx + aa * nx, eta * dy + aa * ny, eta * dz + aa * nz
+                    tl = math.sqrt(tx * tx + ty * ty + tz * tz)
+                    ox, oy, oz = tx / tl, ty / tl, tz / tl
+                    side = -1.0
+            for c in range(3):
+                new_beta[i, c] = beta[i, c] * weight / prob
+        # Russian roulette
+        if roulette:
+            q = min(max(new_beta[i, 0], max(new_beta[i, 1], new_beta[i, 2])), 0.95)
+            if rnd[i, 6] >= q:
+                continue
+            for c in range(3):
+                new_beta[i, c] /= max(q, 1e-12)
+        alive[i] = True
+        new_d[i, 0], new_d[i, 1], new_d[i, 2] = ox, oy, oz
+        new_o[i, 0] = px + side * eps * gx
+        new_o[i, 1] = py + side * eps * gy
+        new_o[i, 2] = pz + side * eps * gz
+    return nee_o, nee_d, nee_t, nee_ok, nee_val, new_o, new_d, new_beta, new_pdf, alive

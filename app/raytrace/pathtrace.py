@@ -31,6 +31,7 @@ import numpy as np
 
 from app.errors import ShadeLabError
 from app.progress import Progress
+from app.raytrace import kernels
 from app.raytrace.accel import Hits
 from app.raytrace.surface import TraceContext, reflect_refract
 from app.raytrace.whitted import stratified_jitter
@@ -50,11 +51,11 @@ class Emitters:
         le = emission[ctx.object_material[g.object_index]] if g.count else np.zeros((0, 3))
         self.index = np.flatnonzero(le.max(axis=1) > 0.0) if g.count else np.zeros(0, int)
         tri = g.triangles[self.index]
-        self.p0 = tri[:, 0]
-        self.e1 = tri[:, 1] - tri[:, 0]
-        self.e2 = tri[:, 2] - tri[:, 0]
-        self.normal = g.face_normals[self.index]
-        self.le = le[self.index]
+        self.p0 = np.ascontiguousarray(tri[:, 0])
+        self.e1 = np.ascontiguousarray(tri[:, 1] - tri[:, 0])
+        self.e2 = np.ascontiguousarray(tri[:, 2] - tri[:, 0])
+        self.normal = np.ascontiguousarray(g.face_normals[self.index])
+        self.le = np.ascontiguousarray(le[self.index])
         areas = 0.5 * np.linalg.norm(np.cross(self.e1, self.e2), axis=1)
         self.total_area = float(areas.sum())
         self.cdf = np.cumsum(areas) / max(self.total_area, 1e-300)
@@ -97,8 +98,9 @@ def cosine_directions(n: np.ndarray, rng: np.random.Generator) -> np.ndarray:
 class PathTracer:
     """The scene prepared once; :meth:`radiance` traces a batch of camera paths."""
 
-    def __init__(self, scene: Scene, backend: str = "auto", ctx: TraceContext | None = None):
-        self.ctx = TraceContext(scene, backend) if ctx is None else ctx
+    def __init__(self, scene: Scene, backend: str = "auto", ctx: TraceContext | None = None,
+                 local: str = "numba"):
+        self.ctx = TraceContext(scene, backend, local=local) if ctx is None else ctx
         mats = self.ctx.materials
         self.rho = np.array([np.multiply(m.kd, m.Od) for m in mats], float).reshape(-1, 3)
         self.kr = np.array([m.mirror for m in mats], float)
@@ -111,6 +113,8 @@ class PathTracer:
     def radiance(self, origins: np.ndarray, dirs: np.ndarray,
                  rng: np.random.Generator) -> np.ndarray:
         """One-sample estimates of L (N, 3) along N camera rays."""
+        if self.ctx.kernels:
+            return self._radiance_kernel(origins, dirs, rng)
         ctx, n = self.ctx, len(origins)
         out = np.zeros((n, 3))
         beta = np.ones((n, 3))
@@ -143,6 +147,43 @@ class PathTracer:
                 survive = rng.random(len(q)) < q
                 alive &= survive
                 beta = beta / np.maximum(q, 1e-12)[:, None]
+            o, d, beta, pixel, bsdf_pdf = (o[alive], d[alive], beta[alive], pixel[alive],
+                                           bsdf_pdf[alive])
+        return out
+
+    def _radiance_kernel(self, origins: np.ndarray, dirs: np.ndarray,
+                         rng: np.random.Generator) -> np.ndarray:
+        """:meth:`radiance` with each path vertex in one numba call (same estimator)."""
+        ctx, n, em = self.ctx, len(origins), self.emitters
+        out = np.zeros((n, 3))
+        beta = np.ones((n, 3))
+        pixel = np.arange(n)
+        bsdf_pdf = np.zeros(n)
+        o, d = origins, dirs
+        for bounce in range(MAX_BOUNCES):
+            if len(o) == 0:
+                break
+            hits = ctx.accel.intersect(o, d)
+            self.rays += len(o)
+            miss = ~hits.hit
+            kernels.add_rows(out, pixel, beta * ctx.background, miss)
+            keep = np.flatnonzero(hits.hit)
+            o, d, beta, pixel, bsdf_pdf = o[keep], d[keep], beta[keep], pixel[keep], bsdf_pdf[keep]
+            t = hits.t[keep]
+            surf = ctx.surface(o, d, Hits(t, hits.tri[keep], hits.u[keep], hits.v[keep]))
+            mat = ctx.object_material[surf.obj]
+            (nee_o, nee_d, nee_t, nee_ok, nee_val, o, d, beta, bsdf_pdf,
+             alive) = kernels.path_vertex(
+                out, pixel, beta, bsdf_pdf, surf.position, surf.normal, surf.geo_normal,
+                surf.entering, np.ascontiguousarray(d), t, mat, self.rho, self.kr, self.kt,
+                self.ior, self.emission, em.cdf, em.p0, em.e1, em.e2, em.normal, em.le,
+                em.total_area, ctx.eps, rng.random((len(t), 7)), bounce >= RR_START)
+            cand = np.flatnonzero(nee_ok)
+            if len(cand):
+                blocked = ctx.accel.occluded(nee_o[cand], nee_d[cand], nee_t[cand],
+                                             everything=True)
+                self.rays += len(cand)
+                kernels.add_rows(out, pixel[cand], nee_val[cand], ~blocked)
             o, d, beta, pixel, bsdf_pdf = (o[alive], d[alive], beta[alive], pixel[alive],
                                            bsdf_pdf[alive])
         return out
@@ -242,7 +283,7 @@ def _add(out: np.ndarray, pixel: np.ndarray, value: np.ndarray) -> None:
 
 
 def iter_pathtrace(scene: Scene, size: tuple[int, int], spp: int, seed: int = 0,
-                   backend: str = "auto") -> Iterator[Progress]:
+                   backend: str = "auto", local: str = "numba") -> Iterator[Progress]:
     """Path-trace progressively: one :class:`Progress` per tile of rows per sample pass.
 
     The image in each Progress is the mean over the samples each pixel has so far
@@ -253,7 +294,7 @@ def iter_pathtrace(scene: Scene, size: tuple[int, int], spp: int, seed: int = 0,
         raise ShadeLabError(f"--size {width}x{height}: expected each side >= 1")
     if spp < 1:
         raise ShadeLabError(f"--spp {spp}: expected an integer >= 1")
-    tracer = PathTracer(scene, backend)
+    tracer = PathTracer(scene, backend, local=local)
     total = np.zeros((height * width, 3))
     count = np.zeros(height * width)
     rows = max(1, TILE_PATHS // width)
