@@ -143,3 +143,94 @@ def _has(module: str) -> bool:
         return importlib.util.find_spec(module) is not None
     except ModuleNotFoundError:
         return False
+
+
+@st.composite
+def trace_materials(draw) -> Material:
+    """Local coefficients plus mirror, glass and emission (what the CPU tracers read)."""
+    m = draw(materials())
+    m.kr = draw(st.sampled_from([-1.0, 0.0, 0.5, 1.0]))
+    m.kt = draw(st.sampled_from([0.0, 0.5, 1.0]))
+    m.ior = draw(st.sampled_from([1.0, 1.33, 1.5, 2.4, 5.0]))
+    m.emission = draw(st.sampled_from([(0.0, 0.0, 0.0), (1.0, 1.0, 1.0), (5.0, 2.0, 0.0)]))
+    return m
+
+
+def _trace_scene(ball: Material, floor: Material, light_list: list[Light]) -> Scene:
+    scene = _tiny_scene(floor, light_list, (0.1, 0.1, 0.1))
+    scene.materials["ball"] = ball
+    scene.objects[0].material = "ball"
+    return scene
+
+
+@pytest.mark.skipif(not _has("app.raytrace.whitted"), reason="ray tracer not built yet")
+@settings(max_examples=15, deadline=None)
+@given(ball=trace_materials(), floor=trace_materials(),
+       light_list=st.lists(lights(), min_size=1, max_size=2),
+       depth=st.integers(0, 6), fresnel=st.booleans())
+def test05_raytracer_is_finite_and_non_negative(ball, floor, light_list, depth, fresnel):
+    from app.raytrace.whitted import render_raytraced
+
+    image = render_raytraced(_trace_scene(ball, floor, light_list), (12, 9), depth, 1,
+                             fresnel)
+    _assert_clean(np.asarray(image, dtype=np.float64), "raytrace")
+
+
+@pytest.mark.skipif(not _has("app.raytrace.pathtrace"), reason="path tracer not built yet")
+@settings(max_examples=10, deadline=None)
+@given(ball=trace_materials(), floor=trace_materials(),
+       light_list=st.lists(lights(), min_size=1, max_size=2), seed=st.integers(0, 1000))
+def test06_pathtracer_is_finite_and_non_negative(ball, floor, light_list, seed):
+    from app.raytrace.pathtrace import iter_pathtrace
+
+    floor.emission = (1.0, 1.0, 1.0)                     # the path tracer needs an emitter
+    steps = list(iter_pathtrace(_trace_scene(ball, floor, light_list), (10, 8), 2, seed))
+    _assert_clean(np.asarray(steps[-1].image, dtype=np.float64), "pathtrace")
+
+
+def _room(rho: list[float], emitter: int, radiance: float) -> Scene:
+    """A closed unit box (six quads, inward normals), one wall emitting."""
+    faces = [
+        [[0, 0, 0], [1, 0, 0], [1, 0, 1], [0, 0, 1]],  # floor, normal +y
+        [[0, 1, 0], [0, 1, 1], [1, 1, 1], [1, 1, 0]],  # ceiling, -y
+        [[0, 0, 0], [0, 0, 1], [0, 1, 1], [0, 1, 0]],  # x = 0, +x
+        [[1, 0, 0], [1, 1, 0], [1, 1, 1], [1, 0, 1]],  # x = 1, -x
+        [[0, 0, 0], [0, 1, 0], [1, 1, 0], [1, 0, 0]],  # z = 0, +z
+        [[0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]],  # z = 1, -z
+    ]
+    scene = Scene(Ia=(0.0, 0.0, 0.0))
+    scene.camera = Camera(eye=(0.5, 0.5, 0.05), target=(0.5, 0.5, 1.0), fov_y=80.0, near=0.01)
+    for i, (poly, r) in enumerate(zip(faces, rho, strict=True)):
+        emission = (radiance,) * 3 if i == emitter else (0.0, 0.0, 0.0)
+        scene.materials[f"m{i}"] = Material(ka=0.0, kd=1.0, ks=0.0, Od=(r, r, r),
+                                            emission=emission)
+        scene.objects.append(Object(shape="quad", material=f"m{i}", normals="flat",
+                                    vertices=[[float(c) for c in p] for p in poly]))
+    return scene
+
+
+@pytest.mark.skipif(not _has("app.radiosity.solvers"), reason="radiosity not built yet")
+@settings(max_examples=15, deadline=None)
+@given(rho=st.lists(st.floats(0.0, 0.95), min_size=6, max_size=6),
+       emitter=st.integers(0, 5), radiance=st.floats(0.01, 100.0),
+       solver=st.sampled_from(["direct", "jacobi", "gauss-seidel", "progressive"]),
+       count=st.integers(6, 60))
+def test07_radiosity_creates_no_energy(rho, emitter, radiance, solver, count):
+    """B >= E, B <= E_max / (1 - rho_max), and absorbed power <= emitted power (rho < 1)."""
+    from app.radiosity.formfactors import FormFactors
+    from app.radiosity.patches import uniform_patches
+    from app.radiosity.solvers import solve
+
+    patches = uniform_patches(_room(rho, emitter, radiance), count)
+    F = FormFactors(patches, "raycast").matrix()
+    B, _ = solve(solver, F, patches.rho, patches.E, patches.areas, iterations=500,
+                 tolerance=1e-7)
+    E, A, r = patches.E, patches.areas, patches.rho
+    _assert_clean(B, f"radiosity {solver}")
+    assert np.all(B >= E * (1 - 1e-9))
+    bound = E.max() / (1.0 - r.max())
+    assert B.max() <= bound * (1 + 2e-3)
+    incident = F @ B                                      # H_i per unit area
+    absorbed = ((1.0 - r) * incident * A[:, None]).sum()
+    emitted = (E * A[:, None]).sum()
+    assert absorbed <= emitted * (1 + 2e-3)

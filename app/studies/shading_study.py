@@ -3,14 +3,14 @@
 The reference intersects every camera ray with the exact sphere and shades the hit with the
 exact normal through :func:`app.shading.reference.shade`; the raster image draws an icosphere
 at subdivision level 0..5 with the GL renderer. Errors are taken on pixels both cover (the
-silhouette mismatch is reported apart), frame times are medians of the GL render + readback.
+silhouette mismatch is reported apart), frame times are the best of several GL renders +
+readback.
 """
 
 from __future__ import annotations
 
 import copy
 import time
-from statistics import median
 
 import numpy as np
 
@@ -101,7 +101,7 @@ def coverage(scene: Scene, size: tuple[int, int]) -> np.ndarray:
 
 def timed_render(scene: Scene, size: tuple[int, int], shading: str, specular: str | None,
                  repeats: int) -> tuple[np.ndarray, float]:
-    """The raster image and the median frame time (render + readback) in milliseconds."""
+    """The raster image and the best frame time of ``repeats`` (render + readback), ms."""
     from app.render.offscreen import render_image
 
     image = render_image(scene, size, shading, specular)  # warm-up: upload, compile
@@ -110,7 +110,7 @@ def timed_render(scene: Scene, size: tuple[int, int], shading: str, specular: st
         start = time.perf_counter()
         image = render_image(scene, size, shading, specular)
         samples.append((time.perf_counter() - start) * 1000.0)
-    return image, median(samples)
+    return image, min(samples)
 
 
 def measure_sphere(scene: Scene, index: int, shading: str, size: tuple[int, int],
@@ -148,6 +148,6 @@ def run_shading(quick: bool = False) -> StudyResult:
         label="level",
         notes=["reference: exact ray-sphere hit, exact normal, app.shading.reference.shade",
                "error on pixels covered by both; 'silhouette' = share covered by one only",
-               "time: median GL render + readback (Mesa llvmpipe or the local GPU)"],
+               "time: best of several GL render + readback (Mesa llvmpipe or the local GPU)"],
         extra={"triangles": by_triangles})
 
