@@ -182,3 +182,27 @@ def test_shadowed_frame_is_ambient_where_masked_and_unchanged_elsewhere(gl_ctx):
     assert np.abs(shadowed[~mask] - lit[~mask]).max() < 2e-3
     assert math.isclose(float(np.median(np.abs(shadowed[~mask] - lit[~mask]))), 0.0,
                         abs_tol=1e-5)
+
+
+def test_cli_teaching_flags_change_the_frame(gl_ctx, tmp_path):
+    from app.cli import main
+
+    out = {}
+    for name, flags in (("plain", []), ("volumes", ["--show-volumes"]),
+                        ("silhouettes", ["--show-silhouettes"]),
+                        ("heatmap", ["--stencil-heatmap"])):
+        code = main(["render", "shadows", "-o", str(tmp_path / f"{name}.png"), "--size", "64x48",
+                     "--npy", str(tmp_path / f"{name}.npy"), *flags])
+        assert code == 0
+        out[name] = np.load(tmp_path / f"{name}.npy")
+    for name in ("volumes", "silhouettes", "heatmap"):
+        changed = np.abs(out[name] - out["plain"]).max(axis=2) > 1e-3
+        assert 0.001 < changed.mean() < 0.9, name
+
+
+def test_cli_rejects_unknown_shadow_method(capsys):
+    from app.cli import main
+
+    code = main(["render", "shadows", "-o", "x.png", "--shadow-method", "zmaybe"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "zmaybe" in err[0]

@@ -17,6 +17,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--specular", choices=SPECULAR_MODELS, help="phong (R.V)^n or blinn (N.H)^n")
     p.add_argument("--shadows", choices=("none", "volumes"), help="stencil shadow volumes")
     p.add_argument("--shadow-method", choices=("zfail", "zpass"), help="stencil counting")
+    p.add_argument("--visibility", choices=("zbuffer", "painter"),
+                   help="hidden surfaces: z-buffer or list priority (painter's algorithm)")
+    p.add_argument("--show-volumes", action="store_true", help="draw shadow volumes, translucent")
+    p.add_argument("--show-silhouettes", action="store_true", help="highlight silhouette edges")
+    p.add_argument("--stencil-heatmap", action="store_true",
+                   help="overlay the stencil count (render.heatmap_light) as a heat map")
     p.add_argument("--error", type=float, metavar="BUDGET",
                    help="auto quality: tessellate each sphere no finer than this relative MSE "
                         "needs (e.g. 0.01; see app.studies.autoquality)")
@@ -36,6 +42,11 @@ def run_render(args: argparse.Namespace) -> int:
     for flag, key in (("shadows", "render.shadows"), ("shadow_method", "render.shadow_method")):
         if getattr(args, flag, None):
             overrides.append(f"{key}={getattr(args, flag)}")
+    if getattr(args, "visibility", None):
+        overrides.append(f"render.visibility={args.visibility}")
+    for flag in ("show_volumes", "show_silhouettes", "stencil_heatmap"):
+        if getattr(args, flag, False):
+            overrides.append(f"render.{flag}=true")
     scene = load_preset(args.preset, overrides)
     if getattr(args, "error", None) is not None:
         from app.studies.autoquality import check_budget
