@@ -20,8 +20,9 @@ Casters
   This is always correct (the union of the per-triangle volumes is the shadow) but costs
   more fill than a silhouette volume. Nothing is refused and nothing is "repaired".
 
-Every volume starts ``offset`` world units beyond the caster along the light's rays, so the
-caster's own surface lies strictly outside its volume (no self-shadowing acne).
+Every volume starts ``offset`` world units beyond the caster (closed casters: along the light's
+rays; per-triangle volumes: along the triangle's normal, away from the light), so the caster's
+own surface lies strictly outside its volume (no self-shadowing acne from depth ties).
 """
 
 from __future__ import annotations
@@ -118,10 +119,11 @@ def _sides(edges: np.ndarray, n: int) -> np.ndarray:
     return np.concatenate([np.stack([b, a, a + n], 1), np.stack([b, a + n, b + n], 1)])
 
 
-def _homogeneous(points: np.ndarray, light: np.ndarray, offset: float) -> np.ndarray:
-    away = away_from_light(points, light)
-    near = np.concatenate([points + offset * away, np.ones((len(points), 1))], axis=1)
-    far = np.concatenate([away, np.zeros((len(points), 1))], axis=1)
+def _homogeneous(points: np.ndarray, light: np.ndarray, shift: np.ndarray) -> np.ndarray:
+    """Near points (moved by ``shift``, w = 1) then the same points at infinity (w = 0)."""
+    moved = points + shift
+    near = np.concatenate([moved, np.ones((len(points), 1))], axis=1)
+    far = np.concatenate([away_from_light(moved, light), np.zeros((len(points), 1))], axis=1)
     return np.concatenate([near, far])
 
 
@@ -139,18 +141,24 @@ def shadow_volume(vertices: np.ndarray, faces: np.ndarray, light: np.ndarray,
         n = len(v)
         dark = f[~lit]
         volume_faces = np.concatenate([_sides(edges, n), dark[:, ::-1], dark + n])
-        return ShadowVolume(_homogeneous(v, light, offset), volume_faces, edges, "silhouette")
+        shift = offset * away_from_light(v, light)  # along the light's rays: stays closed
+        return ShadowVolume(_homogeneous(v, light, shift), volume_faces, edges, "silhouette")
     # Per-triangle volumes: an unshared triangle soup, each turned to face the light.
     tri = vertices[faces]
     lit = facing_light(vertices, faces, light)
     tri = np.where(lit[:, None, None], tri, tri[:, ::-1])
     soup = tri.reshape(-1, 3)
+    # Each cap moves off its triangle along the normal, away from the light: a fixed gap
+    # even where the light grazes the surface (a shift along the rays would shrink to 0).
+    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-300)
+    shift = np.repeat(-offset * normal, 3, axis=0)
     n = len(soup)
     caps = np.arange(n, dtype=np.int64).reshape(-1, 3)
     edges = np.concatenate([caps[:, [0, 1]], caps[:, [1, 2]], caps[:, [2, 0]]])
     volume_faces = np.concatenate([_sides(edges, n), caps, caps[:, ::-1] + n])
     contour = edges[_contour_edges(faces, facing_light(vertices, faces, light))]
-    return ShadowVolume(_homogeneous(soup, light, offset), volume_faces, contour, "per-triangle")
+    return ShadowVolume(_homogeneous(soup, light, shift), volume_faces, contour, "per-triangle")
 
 
 def _contour_edges(faces: np.ndarray, lit: np.ndarray) -> np.ndarray:

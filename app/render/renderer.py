@@ -230,6 +230,7 @@ class Renderer:
             self.draw_objects(scene, opaque, shading)
         shadows.stencil_off()
         self.ctx.depth_func = "<"
+        self.ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA  # the default
         target.fbo.depth_mask = True
         target.fbo.use()
         for variant in self.variants(shading):
