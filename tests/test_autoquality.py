@@ -104,3 +104,23 @@ def test09_raytrace_error_flag(tmp_path, capsys):
     assert "auto quality: depth" in text and out.is_file()
     assert main(["raytrace", "whitted", "-o", str(out), "--error", "-1"]) == 2
     assert capsys.readouterr().err.count("\n") == 1
+
+
+def test10_radiosity_auto_quality():
+    pytest.importorskip("app.radiosity.solution")
+    from app.scene.preset import load_preset
+    from app.studies.radiosity_study import auto_radiosity
+
+    scene = load_preset("radiosity-box")
+    patches, resolution, line = auto_radiosity(scene, (32, 32), 0.05, "raycast",
+                                               counts=(6, 12, 24))
+    assert patches in (6, 12, 24) and resolution == scene.radiosity.hemicube_resolution
+    assert "auto quality:" in line and ("<= 0.05" in line or "best reachable" in line)
+
+
+@pytest.mark.parametrize("value", ["0", "-2", "inf"])
+def test11_radiosity_error_flag_bad_input(tmp_path, capsys, value):
+    pytest.importorskip("app.radiosity.commands")
+    code = main(["radiosity", "cornell", "-o", str(tmp_path / "r.png"), "--error", value])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "--error" in err

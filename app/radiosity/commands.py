@@ -23,6 +23,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                                                      "progressive refinement")
     p.add_argument("--uniform", action="store_true",
                    help="regular patches only (no adaptive subdivision)")
+    p.add_argument("--error", type=float, metavar="BUDGET",
+                   help="auto quality: the fewest uniform patches (and hemicube pixels) within "
+                        "this relative MSE (e.g. 0.01; see app.studies.autoquality)")
     p.set_defaults(run=run_radiosity)
 
 
@@ -31,8 +34,23 @@ def run_radiosity(args: argparse.Namespace) -> int:
     if args.patches is not None:
         check_count(args.patches)
     scene = load_preset(args.preset, args.set)
+    if getattr(args, "error", None) is not None:
+        from app.studies.autoquality import check_budget
+
+        check_budget(args.error)
     check_outputs(args)
     from app.radiosity.solution import iter_radiosity, precheck
+
+    if getattr(args, "error", None) is not None:
+        from app.studies.radiosity_study import auto_radiosity
+
+        precheck(scene, scene.radiosity.patches,
+                 args.form_factors or scene.radiosity.form_factors)
+        args.patches, resolution, line = auto_radiosity(scene, size, args.error,
+                                                        args.form_factors)
+        scene.radiosity.hemicube_resolution = resolution
+        args.uniform = True
+        print(line)
 
     precheck(scene, args.patches or scene.radiosity.patches,
              args.form_factors or scene.radiosity.form_factors)

@@ -111,3 +111,36 @@ def run_radiosity(quick: bool = False) -> StudyResult:
                "convergence: relative residual (progressive: unshot energy share)",
                "'analytic' form factors ignore occlusion (the blocks): a biased floor"],
         extra={"convergence": convergence_table})
+
+
+def auto_radiosity(scene: Scene, size: tuple[int, int], budget: float,
+                   method: str | None = None, max_side: int = 48,
+                   counts=(25, 50, 100, 200)) -> tuple[int, int, str]:
+    """The cheapest uniform patch count (and hemicube resolution, for hemicube form factors)
+    whose image meets ``budget`` in relative MSE against a 4x finer ray-cast solve of the
+    scene itself; returns patches, resolution and a report line."""
+    from app.studies.autoquality import check_budget, choose_setting, front_from_rows
+
+    _require()
+    budget = check_budget(budget)
+    method = method or scene.radiosity.form_factors
+    scale = min(1.0, max_side / max(size))
+    probe = (max(8, round(size[0] * scale)), max(8, round(size[1] * scale)))
+    ref, _ = solve_timed(scene, 4 * max(counts), "raycast", 128, "direct")
+    reference = np.asarray(ref.image(probe), dtype=np.float64)
+    resolutions = (16, 32, 64, 128) if method == "hemicube" else \
+        (scene.radiosity.hemicube_resolution,)
+    records = []
+    for count in counts:
+        for resolution in resolutions:
+            sol, ms = solve_timed(scene, count, method, resolution, "direct")
+            error = metrics.relmse(np.asarray(sol.image(probe), dtype=np.float64), reference)
+            records.append({"patches": count, "resolution": resolution, "time_ms": ms,
+                            "relmse": error})
+    choice = choose_setting(front_from_rows(records, ("patches", "resolution"), "time_ms"),
+                            budget)
+    patches, resolution = choice.point.setting["patches"], choice.point.setting["resolution"]
+    verdict = "<=" if choice.met else "> (best reachable)"
+    detail = f", hemicube {resolution} px" if method == "hemicube" else ""
+    return patches, resolution, (f"auto quality: {patches} patches{detail}: relMSE "
+                                 f"{choice.point.error:.3g} {verdict} {budget:g}")
