@@ -142,3 +142,13 @@ def test10_radiosity_study(gl_ctx):
         values = conv.column("residual", conv.series()[solver])
         assert len(values) > 3 and all(b <= a * (1 + 1e-9) for a, b in
                                        zip(values, values[1:], strict=False))
+
+
+def test11_viewer_registry():
+    from app.studies import STUDIES, StudySkipped, run_study
+
+    assert [name for name, _ in STUDIES] == ["shading", "raytrace", "radiosity", "shadows"]
+    assert all(title for _, title in STUDIES)
+    with pytest.raises(KeyError):
+        run_study("nope")
+    assert issubclass(StudySkipped, Exception)

@@ -3,19 +3,11 @@
 from __future__ import annotations
 
 import argparse
-import importlib
 import sys
 from pathlib import Path
 
 from app.errors import ShadeLabError
-
-# (name, module, function): each function is run_<study>(quick) -> StudyResult
-STUDIES = (
-    ("shading", "app.studies.shading_study", "run_shading"),
-    ("raytrace", "app.studies.raytrace_study", "run_raytrace"),
-    ("radiosity", "app.studies.radiosity_study", "run_radiosity"),
-    ("shadows", "app.studies.shadow_study", "run_shadows"),
-)
+from app.studies import STUDIES, run_study
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -23,7 +15,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", default="charts", metavar="DIR", help="folder to write (created)")
     p.add_argument("--quick", action="store_true", help="small images, few repeats (smoke run)")
     p.add_argument("--only", action="append", default=[], metavar="STUDY",
-                   help=f"run only these studies ({', '.join(s for s, _, _ in STUDIES)})")
+                   help=f"run only these studies ({', '.join(s for s, _ in STUDIES)})")
     p.set_defaults(run=run_charts)
 
     p = sub.add_parser("gallery", help="render the failure gallery, one PNG per case")
@@ -46,22 +38,8 @@ def make_out_dir(text: str) -> Path:
     return path
 
 
-def run_study(name: str, quick: bool):
-    """Import and run one study; returns its StudyResult or raises StudySkipped."""
-    from app.studies.result import StudySkipped
-
-    for study, module_name, function in STUDIES:
-        if study == name:
-            try:
-                module = importlib.import_module(module_name)
-            except ModuleNotFoundError as exc:
-                raise StudySkipped(f"{name}: module {exc.name} is not built yet") from None
-            return getattr(module, function)(quick)
-    raise KeyError(name)
-
-
 def run_charts(args: argparse.Namespace) -> int:
-    known = [s for s, _, _ in STUDIES]
+    known = [s for s, _ in STUDIES]
     for name in args.only:
         if name not in known:
             raise ShadeLabError(f"--only '{name}': expected one of {', '.join(known)}")
