@@ -79,3 +79,17 @@ def test_open_and_inconsistent_casters_get_per_triangle_volumes():
     volume = shadow_volume(box.vertices, flipped, light)
     assert volume.method == "per-triangle"
     assert _closed(volume).is_winding_consistent
+
+
+def test_per_triangle_caps_keep_their_gap_at_grazing_light_and_rays_stay_put():
+    quad = np.array([[0.0, 0, 0], [1, 0, 0], [1, 0, 1], [0, 0, 1]])
+    faces = np.array([[0, 2, 1], [0, 3, 2]])  # normal +y
+    light = light_homogeneous("point", (5.0, 0.5, 0.5), None)  # light 6-12 degrees up
+    volume = shadow_volume(quad, faces, light, offset=0.01)
+    near = volume.vertices[: len(volume.vertices) // 2, :3]
+    # a full offset below the plane, though a plain shift along the rays would leave ~0.001
+    assert np.allclose(near[:, 1], -0.01, atol=1e-9)
+    # and each moved corner stays on the ray from the light through one of the quad's corners
+    d_new = (near - light[:3]) / np.linalg.norm(near - light[:3], axis=1, keepdims=True)
+    d_old = (quad - light[:3]) / np.linalg.norm(quad - light[:3], axis=1, keepdims=True)
+    assert np.all((d_new @ d_old.T).max(axis=1) > 1.0 - 1e-12)

@@ -20,9 +20,11 @@ Casters
   This is always correct (the union of the per-triangle volumes is the shadow) but costs
   more fill than a silhouette volume. Nothing is refused and nothing is "repaired".
 
-Every volume starts ``offset`` world units beyond the caster (closed casters: along the light's
-rays; per-triangle volumes: along the triangle's normal, away from the light), so the caster's
-own surface lies strictly outside its volume (no self-shadowing acne from depth ties).
+Every volume starts beyond its caster along the light's rays (closed casters: ``offset`` world
+units; per-triangle volumes: far enough to be ``offset`` off the triangle's plane, up to
+``GRAZING_LIMIT`` offsets at grazing light), so the caster's own surface lies strictly outside
+its volume (no self-shadowing acne from depth ties) while the shadow's outline, made of rays
+through the silhouette, stays exactly where it is.
 """
 
 from __future__ import annotations
@@ -31,6 +33,8 @@ from dataclasses import dataclass
 
 import numpy as np
 import trimesh
+
+GRAZING_LIMIT = 20.0  # per-triangle caps move at most this many offsets along the rays
 
 
 @dataclass
@@ -148,11 +152,14 @@ def shadow_volume(vertices: np.ndarray, faces: np.ndarray, light: np.ndarray,
     lit = facing_light(vertices, faces, light)
     tri = np.where(lit[:, None, None], tri, tri[:, ::-1])
     soup = tri.reshape(-1, 3)
-    # Each cap moves off its triangle along the normal, away from the light: a fixed gap
-    # even where the light grazes the surface (a shift along the rays would shrink to 0).
+    # Each cap moves along the light's rays (so the shadow's outline does not move) far
+    # enough to leave ``offset`` between it and its triangle even where the light grazes the
+    # surface: t = offset / |N.d|, at most GRAZING_LIMIT times offset.
     normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-300)
-    shift = np.repeat(-offset * normal, 3, axis=0)
+    away = away_from_light(soup, light)
+    cosine = np.abs(np.einsum("ij,ij->i", np.repeat(normal, 3, axis=0), away))
+    shift = (offset / np.maximum(cosine, 1.0 / GRAZING_LIMIT))[:, None] * away
     n = len(soup)
     caps = np.arange(n, dtype=np.int64).reshape(-1, 3)
     edges = np.concatenate([caps[:, [0, 1]], caps[:, [1, 2]], caps[:, [2, 0]]])

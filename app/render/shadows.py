@@ -129,7 +129,8 @@ class ShadowVolumes:
         ctx.enable_only(moderngl.DEPTH_TEST)
         ctx.depth_func = "<"
         GL.glEnable(GL.GL_STENCIL_TEST)
-        GL.glEnable(GL.GL_DEPTH_CLAMP)
+        if method == "zfail":  # far caps at w = 0 may round past depth 1: clamp, never clip
+            GL.glEnable(GL.GL_DEPTH_CLAMP)
         GL.glStencilFunc(GL.GL_ALWAYS, 0, 0xFF)
         if method == "zpass":
             GL.glStencilOpSeparate(GL.GL_FRONT, GL.GL_KEEP, GL.GL_KEEP, GL.GL_INCR_WRAP)
