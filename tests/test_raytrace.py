@@ -300,6 +300,29 @@ def test_bvh_backend_renders_the_same_image():
     assert np.mean(np.abs(a - b) > 1e-3) < 0.01
 
 
+# ------------------------------------------------------------------ progressive, pool
+
+
+def test_progress_fractions_and_cancel():
+    from app.raytrace import whitted
+
+    scene = load_preset("cornell-spheres")
+    gen = whitted.iter_raytrace(scene, (64, 1024), depth=1, spp=2)  # 2 tiles per pass
+    steps = [next(gen), next(gen)]
+    gen.close()
+    assert [s.fraction for s in steps] == [0.25, 0.5]
+    assert steps[0].image[:512].max() > 0 and steps[0].image[512:].max() == 0
+    assert steps[1].stats["primary_rays"] == 64 * 1024
+
+
+def test_two_worker_processes_give_the_same_image():
+    scene = load_preset("cornell-spheres")
+    size = (48, 700)  # 2 tiles
+    serial = render_raytraced(scene, size, depth=2, spp=2)
+    pooled = render_raytraced(scene, size, depth=2, spp=2, workers=2)
+    np.testing.assert_array_equal(serial, pooled)
+
+
 # ------------------------------------------------------------------ command line
 
 
@@ -317,7 +340,7 @@ def test_cli_writes_png_and_npy(tmp_path, capsys):
 
 @pytest.mark.parametrize("argv", [
     ["--depth", "-1"], ["--depth", "65"], ["--spp", "0"], ["--size", "0x10"],
-    ["--set", "lights.0.enabled=false"], ["--depth", "x"],
+    ["--set", "lights.0.enabled=false"], ["--depth", "x"], ["--workers", "0"],
 ])
 def test_cli_bad_input_exits_2_with_one_line(tmp_path, capsys, argv):
     code = main(["raytrace", "cornell-spheres", "-o", str(tmp_path / "a.png"), *argv])

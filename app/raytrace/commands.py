@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 import numpy as np
@@ -13,6 +14,7 @@ from app.raytrace.accel import BACKENDS
 from app.scene.preset import load_preset
 
 MAX_DEPTH = 64
+POOL_MIN_RAYS = 1_000_000  # primary rays from which a 2-process pool pays for its start-up
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -27,6 +29,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--error", type=float, metavar="BUDGET",
                    help="auto quality: the cheapest depth and spp within this relative MSE "
                         "(e.g. 0.01; see app.studies.autoquality)")
+    p.add_argument("--workers", type=int, metavar="N",
+                   help="processes tracing tiles (default: 2 for jobs of 1M+ primary rays, "
+                        "else 1; each costs a second or two to start)")
     p.set_defaults(run=run_raytrace)
 
     p = sub.add_parser("pathtrace", help="Monte Carlo path tracing (reference radiance)")
@@ -38,7 +43,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(run=run_pathtrace)
 
 
-def _check_counts(depth: int | None, spp: int | None) -> None:
+def _check_counts(depth: int | None, spp: int | None, workers: int | None = None) -> None:
+    if workers is not None and not 1 <= workers <= 64:
+        raise ShadeLabError(f"--workers {workers}: expected an integer in [1, 64]")
     if depth is not None and not 0 <= depth <= MAX_DEPTH:
         raise ShadeLabError(f"--depth {depth}: expected an integer in [0, {MAX_DEPTH}]")
     if spp is not None and spp < 1:
@@ -58,7 +65,7 @@ def _note_if_nothing_visible(stats: dict) -> None:
 
 def run_raytrace(args: argparse.Namespace) -> int:
     size = parse_size(args.size)
-    _check_counts(args.depth, args.spp)
+    _check_counts(args.depth, args.spp, args.workers)
     scene = load_preset(args.preset, list(args.set))
     _check_scene(scene, args.preset)
     if not scene.active_lights():
@@ -78,8 +85,13 @@ def run_raytrace(args: argparse.Namespace) -> int:
         args.depth, args.spp, line = auto_raytrace(scene, size, args.error)
         print(line)
 
+    workers = args.workers
+    if workers is None:
+        spp = scene.raytrace.spp if args.spp is None else args.spp
+        big = size[0] * size[1] * spp >= POOL_MIN_RAYS
+        workers = min(2, os.cpu_count() or 1) if big else 1
     last = run_to_end(iter_raytrace(scene, size, args.depth, args.spp, args.fresnel,
-                                    args.backend), desc="raytrace")
+                                    args.backend, workers=workers), desc="raytrace")
     save_outputs(args, last.image, scene.render.exposure)
     _note_if_nothing_visible(last.stats)
     s = last.stats

@@ -24,6 +24,7 @@ import numpy as np
 
 from app.errors import ShadeLabError
 from app.progress import Progress
+from app.raytrace.accel import embree_available
 from app.raytrace.surface import TraceContext
 from app.scene.camera import primary_rays
 from app.scene.model import Scene
@@ -63,22 +64,29 @@ def check_settings(depth: int, spp: int, size: tuple[int, int]) -> None:
 class WavefrontStats:
     """Counters for the figures a render reports."""
 
-    def __init__(self, shadow_start: int = 0):
-        self.shadow_start = shadow_start  # the context's shadow-ray counter at the start
+    def __init__(self):
         self.primary = 0
         self.primary_hits = 0
         self.secondary = 0
+        self.shadow = 0
         self.depth_reached = 0
 
-    def as_dict(self, ctx: TraceContext, elapsed: float) -> dict:
-        shadow = ctx.shadow_rays - self.shadow_start
-        total = self.primary + self.secondary + shadow
+    def merge(self, other: WavefrontStats) -> None:
+        """Add another tile's counters (from a worker process)."""
+        self.primary += other.primary
+        self.primary_hits += other.primary_hits
+        self.secondary += other.secondary
+        self.shadow += other.shadow
+        self.depth_reached = max(self.depth_reached, other.depth_reached)
+
+    def as_dict(self, backend: str, elapsed: float) -> dict:
+        total = self.primary + self.secondary + self.shadow
         return {"primary_rays": self.primary, "primary_hits": self.primary_hits,
                 "secondary_rays": self.secondary,
-                "shadow_rays": shadow, "rays": total,
+                "shadow_rays": self.shadow, "rays": total,
                 "depth_reached": self.depth_reached, "seconds": elapsed,
                 "rays_per_s": total / elapsed if elapsed > 0 else 0.0,
-                "backend": ctx.accel.name}
+                "backend": backend}
 
 
 def trace_batch(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarray, depth: int,
@@ -91,6 +99,7 @@ def trace_batch(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarray, depth:
     min_weight = ctx.scene.raytrace.min_weight if min_weight is None else min_weight
     pixel = np.arange(n)
     weight = np.ones((n, 3))
+    shadow_before = ctx.shadow_rays
     for generation in range(depth + 1):
         if len(origins) == 0:
             break
@@ -116,6 +125,7 @@ def trace_batch(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarray, depth:
             break
         # Spawn the reflected and refracted generation
         origins, dirs, weight, pixel = ctx.spawn(surf, d, w, px, fresnel, min_weight)
+    stats.shadow += ctx.shadow_rays - shadow_before
     return out
 
 
@@ -128,7 +138,7 @@ def _accumulate(out: np.ndarray, pixel: np.ndarray, value: np.ndarray) -> None:
 def iter_raytrace(scene: Scene, size: tuple[int, int], depth: int | None = None,
                   spp: int | None = None, fresnel: bool | None = None,
                   backend: str = "auto", shadows: bool = True, seed: int = 0,
-                  ctx: TraceContext | None = None) -> Iterator[Progress]:
+                  ctx: TraceContext | None = None, workers: int = 1) -> Iterator[Progress]:
     """Trace the scene progressively: one :class:`Progress` per tile of rows per pass.
 
     Parameters
@@ -139,11 +149,16 @@ def iter_raytrace(scene: Scene, size: tuple[int, int], depth: int | None = None,
     backend : "auto" | "embree" | "bvh"
     shadows : False for S_i = 1 everywhere (compare with the raster without volumes)
     seed : random seed of the stratified jitter
+    ctx : a prepared :class:`TraceContext` to reuse (serial mode only)
+    workers : processes tracing tiles in parallel (1: in this process). Each worker
+        builds its own context (Embree is single-threaded per process under the GIL);
+        closing the generator cancels the tiles not started.
 
     Yields
     ------
     Progress with the image so far (H, W, 3) float32 linear, each pixel averaged over the
-    samples it has; stats hold ray counts, rays/s and the depth reached.
+    samples it has; stats hold ray counts, rays/s and the depth reached. The image is the
+    same whatever ``workers`` is.
     """
     settings = scene.raytrace
     depth = settings.depth if depth is None else int(depth)
@@ -151,36 +166,106 @@ def iter_raytrace(scene: Scene, size: tuple[int, int], depth: int | None = None,
     fresnel = settings.fresnel if fresnel is None else bool(fresnel)
     check_settings(depth, spp, size)
     width, height = size
-    ctx = TraceContext(scene, backend, shadows) if ctx is None else ctx
-    stats = WavefrontStats(ctx.shadow_rays)
-    rng = np.random.default_rng(seed)
+    rows = max(1, TILE_RAYS // width)
+    tiles = [(r, min(r + rows, height)) for r in range(0, height, rows)]
+    jobs = [(sample, r0, r1) for sample in range(spp) for r0, r1 in tiles]
+    rays = _tile_rays(scene, size, spp, seed)
+    if workers > 1 and ctx is None and len(jobs) > 1:
+        results = _traced_in_pool(scene, backend, shadows, jobs, rays, depth, fresnel, workers)
+        name = "embree" if backend == "embree" or (backend == "auto" and embree_available()) \
+            else "bvh"
+    else:
+        ctx = TraceContext(scene, backend, shadows) if ctx is None else ctx
+        results = _traced_here(ctx, jobs, rays, depth, fresnel)
+        name = ctx.accel.name
+    stats = WavefrontStats()
     total = np.zeros((height * width, 3))
     count = np.zeros(height * width)
     image = np.zeros((height, width, 3), np.float32)
-    rows = max(1, TILE_RAYS // width)
-    tiles = [(r, min(r + rows, height)) for r in range(0, height, rows)]
     start = time.perf_counter()
-    for sample in range(spp):
-        jitter = stratified_jitter(spp, sample, (height, width), rng)
-        origins, dirs = primary_rays(scene.camera, width, height, jitter)
-        for t, (r0, r1) in enumerate(tiles):
-            o = origins[r0:r1].reshape(-1, 3)
-            d = dirs[r0:r1].reshape(-1, 3)
-            rows_done = slice(r0 * width, r1 * width)
-            total[rows_done] += trace_batch(ctx, o, d, depth, fresnel, stats)
-            count[rows_done] += 1
-            image[r0:r1] = (total[rows_done] / count[rows_done, None]).reshape(r1 - r0, width, 3)
-            done = (sample * len(tiles) + t + 1) / (spp * len(tiles))
-            yield Progress(image.copy(), done,
-                           f"pass {sample + 1}/{spp}, rows {r1}/{height}",
-                           stats.as_dict(ctx, time.perf_counter() - start))
+    for done, ((sample, r0, r1), radiance, tile_stats) in enumerate(results, 1):
+        stats.merge(tile_stats)
+        rows_done = slice(r0 * width, r1 * width)
+        total[rows_done] += radiance
+        count[rows_done] += 1
+        image[r0:r1] = (total[rows_done] / count[rows_done, None]).reshape(r1 - r0, width, 3)
+        yield Progress(image.copy(), done / len(jobs),
+                       f"pass {sample + 1}/{spp}, rows {r1}/{height}",
+                       {**stats.as_dict(name, time.perf_counter() - start), "workers": workers})
+
+
+def _tile_rays(scene: Scene, size: tuple[int, int], spp: int, seed: int):
+    """rays(sample, r0, r1) -> (origins, dirs) of a tile, flattened; one pass cached."""
+    width, height = size
+    rng = np.random.default_rng(seed)
+    cache: dict = {}
+
+    def rays(sample: int, r0: int, r1: int):
+        if cache.get("sample") != sample:
+            # Passes are asked for in order, so the rng stream is the same as a plain loop
+            jitter = stratified_jitter(spp, sample, (height, width), rng)
+            cache["sample"] = sample
+            cache["rays"] = primary_rays(scene.camera, width, height, jitter)
+        origins, dirs = cache["rays"]
+        return origins[r0:r1].reshape(-1, 3), dirs[r0:r1].reshape(-1, 3)
+
+    return rays
+
+
+def _traced_here(ctx: TraceContext, jobs: list, rays, depth: int, fresnel: bool):
+    for job in jobs:
+        stats = WavefrontStats()
+        o, d = rays(*job)
+        yield job, trace_batch(ctx, o, d, depth, fresnel, stats), stats
+
+
+_WORKER_CTX: TraceContext | None = None
+
+
+def _init_worker(scene: Scene, backend: str, shadows: bool) -> None:
+    global _WORKER_CTX
+    _WORKER_CTX = TraceContext(scene, backend, shadows)
+
+
+def _trace_tile(o: np.ndarray, d: np.ndarray, depth: int, fresnel: bool):
+    stats = WavefrontStats()
+    return trace_batch(_WORKER_CTX, o, d, depth, fresnel, stats), stats
+
+
+def _traced_in_pool(scene: Scene, backend: str, shadows: bool, jobs: list, rays, depth: int,
+                    fresnel: bool, workers: int):
+    """Tiles traced by ``workers`` spawned processes, in job order, a few in flight."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    pool = ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"),
+                               initializer=_init_worker, initargs=(scene, backend, shadows))
+    pending: list = []
+    try:
+        queue = iter(jobs)
+        for job in queue:
+            pending.append((job, pool.submit(_trace_tile, *rays(*job), depth, fresnel)))
+            if len(pending) >= 2 * workers:
+                break
+        while pending:
+            job, future = pending.pop(0)
+            radiance, stats = future.result()
+            next_job = next(queue, None)
+            if next_job is not None:
+                pending.append((next_job, pool.submit(_trace_tile, *rays(*next_job), depth,
+                                                      fresnel)))
+            yield job, radiance, stats
+    finally:
+        pool.shutdown(wait=False, cancel_futures=True)
 
 
 def render_raytraced(scene: Scene, size: tuple[int, int], depth: int | None = None,
                      spp: int | None = None, fresnel: bool | None = None,
-                     backend: str = "auto", shadows: bool = True) -> np.ndarray:
+                     backend: str = "auto", shadows: bool = True,
+                     workers: int = 1) -> np.ndarray:
     """The finished ray-traced image (H, W, 3) float32 linear."""
     last = None
-    for step in iter_raytrace(scene, size, depth, spp, fresnel, backend, shadows):
+    for step in iter_raytrace(scene, size, depth, spp, fresnel, backend, shadows,
+                              workers=workers):
         last = step
     return last.image
