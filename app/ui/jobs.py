@@ -37,6 +37,7 @@ class JobRunner:
         self.started = 0.0
         self.finished = 0.0
         self.cancelled = False
+        self.cancel_requested = 0.0     # perf_counter() of the last cancel
         self.version = 0                # bumps on every new Progress (the UI re-uploads then)
         self._cancel = threading.Event()
         self._thread: threading.Thread | None = None
@@ -82,6 +83,8 @@ class JobRunner:
             self.finished = time.perf_counter()
 
     def cancel(self, wait: bool = False, timeout: float = 5.0) -> None:
+        if self.running and not self._cancel.is_set():
+            self.cancel_requested = time.perf_counter()
         self._cancel.set()
         if wait and self._thread is not None:
             self._thread.join(timeout)
