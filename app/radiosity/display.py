@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from app.radiosity.patches import PatchSet
+from app.radiosity.patches import FINE, PatchSet
 
 Mesh = tuple[np.ndarray, np.ndarray, np.ndarray]  # vertices (V,3), faces (F,3), radiance (V,3)
 
@@ -46,6 +46,8 @@ def _quad_display(patches: PatchSet, index: int, members: np.ndarray, radiance: 
     inside = ((px >= rects[:, 0:1]) & (px <= rects[:, 2:3]) & (py >= rects[:, 1:2])
               & (py <= rects[:, 3:4]))  # (leaves, V)
     values = _area_average(inside, patches.areas[members], radiance[members])
+    values = _extrapolate_boundary(points, inverse, surface, patches.areas[members],
+                                   radiance[members], values)
     vertices = surface.point(points[:, 0], points[:, 1])
     faces, extra_v, extra_c = [], [], []
     for k in range(len(members)):
@@ -67,6 +69,31 @@ def _quad_display(patches: PatchSet, index: int, members: np.ndarray, radiance: 
         vertices = np.concatenate([vertices, np.asarray(extra_v)])
         values = np.concatenate([values, np.asarray(extra_c)])
     return vertices, np.asarray(faces, np.int64), values
+
+
+def _extrapolate_boundary(points, corners, surface, areas, radiance, values) -> np.ndarray:
+    """Boundary vertices extrapolated through their patch: 2 B_k - (opposite corner), averaged
+    over the patches at the vertex and kept >= 0.
+
+    A plain average puts a boundary vertex at its patches' mean, which flattens the fall-off
+    into corners and along shadowed edges; extrapolating from the interior keeps the slope
+    (Cohen & Wallace 1993, "Radiosity and Realistic Image Synthesis", ch. 9).
+    """
+    extent = (surface.grid[0] * FINE, surface.grid[1] * FINE)
+    x, y = points[:, 0], points[:, 1]
+    boundary = (x == 0) | (y == 0) | (x == extent[0]) | (y == extent[1])
+    total = np.zeros_like(values)
+    weight = np.zeros(len(values))
+    for k in range(len(corners)):
+        for c in range(4):
+            b, o = corners[k, c], corners[k, (c + 2) % 4]
+            if boundary[b] and not boundary[o]:
+                total[b] += areas[k] * (2.0 * radiance[k] - values[o])
+                weight[b] += areas[k]
+    done = weight > 0
+    out = values.copy()
+    out[done] = np.maximum(total[done] / weight[done, None], 0.0)
+    return out
 
 
 def _perimeter(points: np.ndarray, x0, y0, x1, y1) -> np.ndarray:

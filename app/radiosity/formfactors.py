@@ -22,6 +22,7 @@ shooting before the whole matrix exists, as it did in Cohen et al. 1988.
 from __future__ import annotations
 
 import math
+from typing import Iterator
 
 import numba
 import numpy as np
@@ -122,8 +123,12 @@ def _faces(pi, ni, pj, nj, eps):
 
 
 @numba.njit(cache=True)
-def _unoccluded(rows, polygons, normals, recv, eps):
-    """Per-point unoccluded kernels (len(rows), N, K) (zero where j cannot be seen)."""
+def _unoccluded(rows, polygons, normals, recv, eps, areas, half):
+    """Per-point unoccluded kernels (len(rows), N, K) (zero where j cannot be seen).
+
+    With ``half`` only the pairs whose receiver i is the smaller patch (ties: i < j) are
+    computed; reciprocity gives the others.
+    """
     n = len(polygons)
     k_count = recv.shape[1]
     out = np.zeros((len(rows), n, k_count))
@@ -131,6 +136,8 @@ def _unoccluded(rows, polygons, normals, recv, eps):
     for a in range(len(rows)):
         i = rows[a]
         for j in range(n):
+            if half and (areas[i] > areas[j] or (areas[i] == areas[j] and i > j)):
+                continue
             if j == i or not _faces(polygons[i], normals[i], polygons[j], normals[j], eps):
                 continue
             for k in range(k_count):
@@ -226,15 +233,45 @@ class FormFactors:
         return np.stack([self._rows[int(r)] for r in rows])
 
     def matrix(self) -> np.ndarray:
-        """The full (N, N) matrix F, F[i, j] = F_ij."""
+        """The full (N, N) matrix F, F[i, j] = F_ij.
+
+        Ray-cast and analytic factors are computed once per pair, from the smaller patch
+        (quadrature over it, the exact kernel over the larger one, as Baum et al. 1989
+        advise), and the other direction follows by reciprocity A_i F_ij = A_j F_ji: half the
+        work, and a matrix reciprocal to rounding, so shooting and gathering solve one system.
+        """
+        for _ in self.iter_matrix():
+            pass
         return self.compute_rows(np.arange(self.n))
 
+    def iter_matrix(self, blocks: int = 20) -> Iterator[float]:
+        """Compute the full matrix in about ``blocks`` steps, yielding the share done."""
+        rows_per = max(1, self.n // blocks)
+        if self.method == "hemicube":
+            for start in range(0, self.n, rows_per):
+                self.compute_rows(np.arange(start, min(start + rows_per, self.n)))
+                yield min(start + rows_per, self.n) / self.n
+            return
+        if len(self._rows) == self.n:
+            return
+        half = np.zeros((self.n, self.n))
+        limit = max(1, MAX_RAYS_PER_BATCH // max(1, self.n * 9 * self.rays // 2))
+        for start in range(0, self.n, min(rows_per, limit)):
+            rows = np.arange(start, min(start + min(rows_per, limit), self.n))
+            half[rows] = self._compute(rows, half=True)
+            yield rows[-1] / self.n
+        areas = self.patches.areas
+        F = half + (half * areas[:, None]).T / areas[:, None]
+        for i in range(self.n):
+            self._rows[i] = F[i]
+        yield 1.0
+
     # ------------------------------------------------------------ methods
-    def _compute(self, rows: np.ndarray) -> np.ndarray:
+    def _compute(self, rows: np.ndarray, half: bool = False) -> np.ndarray:
         if self.method == "hemicube":
             return self._hemicube_rows(rows)
         p = self.patches
-        kernel = _unoccluded(rows, p.polygons, p.normals, self._recv, self.eps)
+        kernel = _unoccluded(rows, p.polygons, p.normals, self._recv, self.eps, p.areas, half)
         if self.method == "raycast":
             kernel = kernel * self._visibility(rows, kernel)
         return np.einsum("ajk,ak->aj", kernel, self._recv_w[rows])

@@ -145,11 +145,12 @@ def _refine_candidates(patches: PatchSet, radiance: np.ndarray, splits: int) -> 
             corners = patches.polygons[k]
             near = np.linalg.norm(vertices[None, :, :] - corners[:, None, :], axis=2)
             ids = np.argmin(near, axis=1)
-            score[k] = np.abs(y[ids] - luminance[k]).max() / scale
+            score[k] = np.abs(y[ids] - luminance[k]).max() / scale * patches.areas[k]
     splittable = (patches.rects[:, 0] >= 0) & ((patches.rects[:, 2] - patches.rects[:, 0]) > 1)
     score[~splittable | ~lit] = 0.0
     order = np.argsort(-score)
-    return order[:splits][score[order[:splits]] > REFINE_CONTRAST]
+    mean_area = float(patches.areas.mean())
+    return order[:splits][score[order[:splits]] > REFINE_CONTRAST * mean_area]
 
 
 # ---------------------------------------------------------------------- solving
@@ -169,77 +170,114 @@ def iter_radiosity(scene: Scene, size: tuple[int, int] | None = None, patches: i
                    image_every: float = 0.25) -> Iterator[Progress]:
     """Radiosity as a progressive job: yields :class:`Progress` after each chunk of work.
 
-    ``image`` is a CPU rendering of the current solution from the scene camera (``size`` =
-    (W, H); None: no images); progressive refinement yields a lit image right after its first
-    shot. ``stats`` holds ``patches``, ``form_factors``, ``solver``, timings and ``history``
-    (iteration, residual, unshot, time_s), and, at the end, ``solution`` (a
-    :class:`RadiositySolution`). Close the generator to cancel.
+    With ``adaptive`` the job solves a coarse uniform mesh first (``REFINE_SHARE`` of the
+    target), splits the leaves where radiosity changes fast, and solves again, up to
+    ``REFINE_ROUNDS`` times: each stage shows a complete picture, and progressive refinement
+    yields a lit image right after its first shot. ``image`` is a CPU rendering of the
+    current solution from the scene camera (``size`` = (W, H); None: no images). ``stats``
+    holds ``patches``, ``form_factors``, ``solver``, ``stage``, timings and ``history``
+    (iteration, residual, unshot, time_s of the current stage's solver), and, at the end,
+    ``solution`` (a :class:`RadiositySolution`). Close the generator to cancel.
     """
     count, method, solver = _settings(scene, patches, form_factors, solver)
     resolution = resolution or scene.radiosity.hemicube_resolution
     precheck(scene, count, method)
     start = time.perf_counter()
-    stats = {"form_factors": method, "solver": solver}
+    stats = {"form_factors": method, "solver": solver, "target_patches": count}
     yield Progress(None, 0.0, "meshing", dict(stats))
-    mesh = mesh_scene(scene, count, method, adaptive, resolution)
-    stats.update(patches=len(mesh), meshing_s=time.perf_counter() - start)
+    refine = adaptive and count >= 8
+    mesh = uniform_patches(scene, max(1, int(count * REFINE_SHARE)) if refine else count)
+    stages = REFINE_ROUNDS + 1 if refine else 1
+    for stage in range(stages):
+        stats.update(stage=f"{stage + 1}/{stages}", patches=len(mesh),
+                     meshing_s=time.perf_counter() - start)
+        band = (stage / stages, (stage + 1) / stages)
+        B = yield from _solve_stage(scene, mesh, method, solver, resolution, size, image_every,
+                                    stats, band, start, final=stage == stages - 1)
+        if stage == stages - 1:
+            break
+        budget = count if stage == stages - 2 else len(mesh) + (count - len(mesh)) // 2
+        chosen = _refine_candidates(mesh, B / math.pi, (budget - len(mesh)) // 3)
+        if len(chosen) == 0:  # flat everywhere: the coarse mesh is the answer
+            stats["refined_out"] = True
+            yield from _finish(scene, mesh, B, stats, size, start)
+            return
+        mesh = split_leaves(scene, mesh, chosen)
+
+
+def _solve_stage(scene, mesh, method, solver, resolution, size, image_every, stats, band,
+                 start, final):
+    """Form factors and a solve of one mesh, yielding progress; returns the display B."""
+    settings = scene.radiosity
     ff = FormFactors(mesh, method, resolution)
     history = new_history()
     stats["history"] = history
+    span = band[1] - band[0]
     if solver == "progressive":
-        steps = run_solver(solver, None, mesh.rho, mesh.E, scene.radiosity.iterations,
-                           scene.radiosity.tolerance, row=ff.row, areas=mesh.areas)
-        ff_seconds = 0.0
+        steps = run_solver(solver, None, mesh.rho, mesh.E, settings.iterations,
+                           settings.tolerance, row=ff.row, areas=mesh.areas)
     else:
         t0 = time.perf_counter()
-        block = max(1, len(mesh) // 20)
-        for first in range(0, len(mesh), block):
-            ff.compute_rows(np.arange(first, min(first + block, len(mesh))))
-            done = min(first + block, len(mesh)) / len(mesh)
-            yield Progress(None, 0.05 + 0.6 * done, f"form factors {int(done * 100)}%",
-                           dict(stats))
+        for done in ff.iter_matrix():
+            yield Progress(None, band[0] + 0.6 * span * done,
+                           f"form factors {int(done * 100)}% ({len(mesh)} patches)", dict(stats))
         F = ff.matrix()
-        ff_seconds = time.perf_counter() - t0
-        stats["form_factors_s"] = ff_seconds
+        stats["form_factors_s"] = time.perf_counter() - t0
         check_solvable(F, mesh.rho, lambda: _rho_names(scene, mesh))
-        steps = run_solver(solver, F, mesh.rho, mesh.E, scene.radiosity.iterations,
-                           scene.radiosity.tolerance, areas=mesh.areas)
-    yield from _drive(scene, mesh, steps, history, stats, size, image_every, start)
+        steps = run_solver(solver, F, mesh.rho, mesh.E, settings.iterations,
+                           settings.tolerance, areas=mesh.areas)
+    last = yield from _drive(scene, mesh, steps, history, stats, size, image_every, start,
+                             (band[0] + 0.6 * span if solver != "progressive" else band[0],
+                              band[1]))
+    stats["solve_s"] = last.seconds
+    value = last.unshot if np.isnan(last.residual) else last.residual
+    stats["converged"] = bool(value <= settings.tolerance) or solver == "direct"
+    B = last.display_B(mesh.rho).copy()
+    if final:
+        yield from _finish(scene, mesh, B, stats, size, start)
+    return B
 
 
-def _drive(scene, mesh, steps, history, stats, size, image_every, start) -> Iterator[Progress]:
-    """Run solver steps in chunks, yielding progress (and images) between them."""
+def _finish(scene, mesh, B, stats, size, start) -> Iterator[Progress]:
+    stats["patches"] = len(mesh)
+    stats["total_s"] = time.perf_counter() - start
+    solution = RadiositySolution(scene, mesh, B, stats)
+    stats["solution"] = solution
+    image = solution.image(size) if size is not None else None
+    yield Progress(image, 1.0, f"done: {len(mesh)} patches", stats)
+
+
+def _drive(scene, mesh, steps, history, stats, size, image_every, start, band):
+    """Run solver steps in chunks, yielding progress (and images) between them; returns the
+    last step."""
     last: Step | None = None
     last_image = -1e9
     chunk_start = time.perf_counter()
     first = True
     for last in steps:
         record(history, last)
-        if first and np.isnan(last.residual):
+        if first and "first_shot_s" not in stats and np.isnan(last.residual):
             stats["first_shot_s"] = time.perf_counter() - start
         now = time.perf_counter()
         if now - chunk_start < CHUNK_SECONDS and not first:
             continue
-        chunk_start, first = now, False
+        chunk_start = now
         fraction = _fraction(last, scene)
-        solution = RadiositySolution(scene, mesh, last.display_B(mesh.rho), dict(stats))
         image = None
-        if size is not None and (now - last_image >= image_every or len(history["time_s"]) == 1):
+        if size is not None and (now - last_image >= image_every or first):
+            solution = RadiositySolution(scene, mesh, last.display_B(mesh.rho), dict(stats))
             image = solution.image(size)
             last_image = time.perf_counter()
+            if "first_image_s" not in stats:
+                stats["first_image_s"] = last_image - start
+        first = False
         message = (f"shot {last.iteration}, unshot {last.unshot:.2e}" if np.isnan(last.residual)
                    else f"iteration {last.iteration}, residual {last.residual:.2e}")
-        yield Progress(image, 0.65 + 0.34 * fraction, message, dict(stats))
+        yield Progress(image, band[0] + (band[1] - band[0]) * 0.99 * fraction,
+                       f"{message} ({len(mesh)} patches)", dict(stats))
     if last is None:
         raise ShadeLabError("radiosity: the solver produced no result")
-    stats["solve_s"] = last.seconds
-    final = last.unshot if np.isnan(last.residual) else last.residual
-    stats["converged"] = bool(final <= scene.radiosity.tolerance) or stats["solver"] == "direct"
-    stats["total_s"] = time.perf_counter() - start
-    solution = RadiositySolution(scene, mesh, last.display_B(mesh.rho).copy(), stats)
-    stats["solution"] = solution
-    image = solution.image(size) if size is not None else None
-    yield Progress(image, 1.0, f"done: {len(mesh)} patches", stats)
+    return last
 
 
 def _fraction(step: Step, scene: Scene) -> float:

@@ -193,7 +193,13 @@ def run_solver(name: str, F: np.ndarray | None, rho: np.ndarray, E: np.ndarray,
                iterations: int = 200, tolerance: float = 1e-4,
                row: Callable[[int], np.ndarray] | None = None,
                areas: np.ndarray | None = None) -> Iterator[Step]:
-    """The named solver's steps (``F`` for gathering; ``row`` and ``areas`` for shooting)."""
+    """The named solver's steps (``F`` for gathering; ``row`` and ``areas`` for shooting).
+
+    A system without a bounded solution is refused first (:func:`check_solvable`) when F is
+    known.
+    """
+    if F is not None:
+        check_solvable(F, rho)
     if name == "direct":
         return solve_direct(F, rho, E)
     if name == "jacobi":
