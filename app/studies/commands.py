@@ -73,6 +73,9 @@ def run_gallery(args: argparse.Namespace) -> int:
         if name not in names:
             raise ShadeLabError(f"--only '{name}': expected one of {', '.join(names)}")
     out = make_out_dir(args.out)
+    index = ["# ShadeLab failure gallery", "",
+             "Written by `shadelab gallery`; each case is `PRESET` + `--set` overrides, drawn "
+             "with its method. Reproduce one in the viewer with `shadelab PRESET --set ...`.", ""]
     for case in GALLERY:
         if args.only and case.name not in args.only:
             continue
@@ -84,4 +87,10 @@ def run_gallery(args: argparse.Namespace) -> int:
         path = out / f"{case.name}.png"
         write_png(str(path), image, exposure)
         print(f"wrote {path}")
+        sets = " ".join(f"--set {o}" for o in case.overrides)
+        index += [f"## {case.name}", "", f"![{case.name}]({case.name}.png)", "",
+                  f"`{case.preset}` {sets} ({case.method}); test `{case.test_name}`", "",
+                  case.explanation, ""]
+    if not args.only:
+        (out / "index.md").write_text("\n".join(index), encoding="utf-8")
     return 0

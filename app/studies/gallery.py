@@ -3,7 +3,7 @@
 ``GALLERY`` is plain data the viewer lists (name, preset, ``--set`` overrides, method,
 explanation, the test that pins the failure down); :func:`render_case` draws one case with
 its method, and ``shadelab gallery --out DIR`` writes one PNG per case whose renderer exists.
-A method is ``raster:<shading>``, ``raytrace``, ``pathtrace`` or ``radiosity``.
+A method is ``raster:<shading>``, ``raytrace``, ``pathtrace[:<spp>]`` or ``radiosity``.
 """
 
 from __future__ import annotations
@@ -177,6 +177,11 @@ def render_case(case: GalleryCase, size: tuple[int, int]) -> tuple[np.ndarray, f
         from app.raytrace.whitted import render_raytraced
 
         image = render_raytraced(scene, size)
+    elif kind == "pathtrace":
+        from app.raytrace.pathtrace import iter_pathtrace
+
+        *_, last = iter_pathtrace(scene, size, int(variant or 16))
+        image = last.image
     elif kind == "radiosity":
         image = _render_radiosity(scene, size)
     else:

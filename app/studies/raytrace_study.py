@@ -43,17 +43,17 @@ def measure(scene: Scene, size: tuple[int, int], depths, spps, reference: tuple[
 
     ctx = TraceContext(scene)
     ref, _ = trace(scene, size, reference[0], reference[1], ctx, seed=12345)
-    rows = []
-    for spp in spps:
-        for depth in depths:
-            times = []
-            for _ in range(repeats):
-                image, ms = trace(scene, size, depth, spp, ctx)
-                times.append(ms)
-            errors = metrics.all_metrics(image, ref)
-            rows.append([depth, spp, min(times), errors["mae"], errors["rmse"],
-                         errors["relmse"]])
-    return rows
+    settings = [(depth, spp) for spp in spps for depth in depths]
+    best = {key: float("inf") for key in settings}
+    errors = {}
+    for _ in range(repeats):  # rounds over all settings spread the machine's load evenly
+        for depth, spp in settings:
+            image, ms = trace(scene, size, depth, spp, ctx)
+            best[(depth, spp)] = min(best[(depth, spp)], ms)
+            errors[(depth, spp)] = metrics.all_metrics(image, ref)
+    return [[depth, spp, best[(depth, spp)], errors[(depth, spp)]["mae"],
+             errors[(depth, spp)]["rmse"], errors[(depth, spp)]["relmse"]]
+            for depth, spp in settings]
 
 
 def run_raytrace(quick: bool = False) -> StudyResult:
