@@ -98,6 +98,8 @@ def local_shade(position, normal, to_eye, mat, mats, lights, ia, blinn, shadow):
         for c in range(3):
             r[c] = mats[m, M_LE + c] + ia[c] * ka * mats[m, M_OD + c]
         for k in range(len(lights)):
+            if (kd == 0.0 and ks == 0.0) or shadow[k, i] == 0.0:
+                continue  # adds exactly 0 (mirror, glass, or a shadowed light)
             lx, ly, lz, dist = _to_light(lights, k, px, py, pz)
             # f_att
             att = lights[k, L_ATT]
@@ -121,7 +123,7 @@ def local_shade(position, normal, to_eye, mat, mats, lights, ia, blinn, shadow):
             ndl = nx * lx + ny * ly + nz * lz
             lam = max(ndl, 0.0)
             spec = 0.0
-            if ndl > 0.0:
+            if ndl > 0.0 and ks != 0.0:
                 if blinn:
                     hx, hy, hz = lx + vx, ly + vy, lz + vz
                     hl = math.sqrt(hx * hx + hy * hy + hz * hz)
@@ -400,3 +402,45 @@ def path_vertex(out, pixel, beta, bsdf_pdf, position, normal, geo, entering, dir
         new_o[i, 1] = py + side * eps * gy
         new_o[i, 2] = pz + side * eps * gz
     return nee_o, nee_d, nee_t, nee_ok, nee_val, new_o, new_d, new_beta, new_pdf, alive
+
+
+@nb.njit(cache=True)
+def camera_rays(eye, forward, right, up, tan_half, width, height, r0, r1, jitter):
+    """Rows r0..r1 of :func:`app.scene.camera.primary_rays`, flattened (same formulas);
+    ``jitter`` (r1 - r0, width, 2), or shape (0, 0, 2) for pixel centres."""
+    n = (r1 - r0) * width
+    origins = np.empty((n, 3))
+    dirs = np.empty((n, 3))
+    aspect = width / height
+    centre = jitter.shape[0] == 0
+    for j in range(r0, r1):
+        for i in range(width):
+            k = (j - r0) * width + i
+            jx = 0.5 if centre else jitter[j - r0, i, 0]
+            jy = 0.5 if centre else jitter[j - r0, i, 1]
+            x = (2.0 * ((i + jx) / width) - 1.0) * tan_half * aspect
+            y = (1.0 - 2.0 * ((j + jy) / height)) * tan_half
+            dx = forward[0] + x * right[0] + y * up[0]
+            dy = forward[1] + x * right[1] + y * up[1]
+            dz = forward[2] + x * right[2] + y * up[2]
+            length = math.sqrt(dx * dx + dy * dy + dz * dz)
+            dirs[k, 0], dirs[k, 1], dirs[k, 2] = dx / length, dy / length, dz / length
+            origins[k, 0], origins[k, 1], origins[k, 2] = eye[0], eye[1], eye[2]
+    return origins, dirs
+
+
+@nb.njit(cache=True)
+def add_weighted(out, pixel, weight, value):
+    """out[pixel[i]] += weight[i] * value[i] (RGB)."""
+    for i in range(len(pixel)):
+        for c in range(3):
+            out[pixel[i], c] += weight[i, c] * value[i, c]
+
+
+@nb.njit(cache=True)
+def add_background(out, pixel, weight, hit, background):
+    """out[pixel[i]] += weight[i] * background where the ray missed."""
+    for i in range(len(pixel)):
+        if not hit[i]:
+            for c in range(3):
+                out[pixel[i], c] += weight[i, c] * background[c]

@@ -24,9 +24,9 @@ import numpy as np
 
 from app.errors import ShadeLabError
 from app.progress import Progress
+from app.raytrace import kernels
 from app.raytrace.accel import embree_available
 from app.raytrace.surface import TraceContext
-from app.scene.camera import primary_rays
 from app.scene.model import Scene
 
 TILE_RAYS = 32768  # primary rays per work unit (keeps a chunk well under 0.2 s)
@@ -110,8 +110,7 @@ def trace_batch(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarray, depth:
             stats.primary += len(origins)
         hits = ctx.accel.intersect(origins, dirs)
         # Misses see the background
-        miss = ~hits.hit
-        _accumulate(out, pixel[miss], weight[miss] * ctx.background)
+        kernels.add_background(out, pixel, weight, hits.hit, ctx.background)
         hit = np.flatnonzero(hits.hit)
         if generation == 0:
             stats.primary_hits += len(hit)
@@ -120,19 +119,13 @@ def trace_batch(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarray, depth:
         o, d, w, px = origins[hit], dirs[hit], weight[hit], pixel[hit]
         sub = type(hits)(hits.t[hit], hits.tri[hit], hits.u[hit], hits.v[hit])
         surf = ctx.surface(o, d, sub)
-        _accumulate(out, px, w * ctx.local(surf, d))
+        kernels.add_weighted(out, px, w, ctx.local(surf, d))
         if generation == depth:
             break
         # Spawn the reflected and refracted generation
         origins, dirs, weight, pixel = ctx.spawn(surf, d, w, px, fresnel, min_weight)
     stats.shadow += ctx.shadow_rays - shadow_before
     return out
-
-
-def _accumulate(out: np.ndarray, pixel: np.ndarray, value: np.ndarray) -> None:
-    if len(pixel):
-        for c in range(3):
-            out[:, c] += np.bincount(pixel, weights=value[:, c], minlength=len(out))
 
 
 def iter_raytrace(scene: Scene, size: tuple[int, int], depth: int | None = None,
@@ -195,9 +188,16 @@ def iter_raytrace(scene: Scene, size: tuple[int, int], depth: int | None = None,
 
 
 def _tile_rays(scene: Scene, size: tuple[int, int], spp: int, seed: int):
-    """rays(sample, r0, r1) -> (origins, dirs) of a tile, flattened; one pass cached."""
+    """rays(sample, r0, r1) -> (origins, dirs) of a tile, flattened, as
+    :func:`app.scene.camera.primary_rays` gives them (a numba mirror, per tile)."""
+    from app.scene.camera import _basis  # the camera's own frame, so the images align
+
     width, height = size
     rng = np.random.default_rng(seed)
+    cam = scene.camera
+    forward, right, up = _basis(cam)
+    eye = np.asarray(cam.eye, dtype=np.float64)
+    tan_half = math.tan(math.radians(cam.fov_y) / 2.0)
     cache: dict = {}
 
     def rays(sample: int, r0: int, r1: int):
@@ -205,9 +205,11 @@ def _tile_rays(scene: Scene, size: tuple[int, int], spp: int, seed: int):
             # Passes are asked for in order, so the rng stream is the same as a plain loop
             jitter = stratified_jitter(spp, sample, (height, width), rng)
             cache["sample"] = sample
-            cache["rays"] = primary_rays(scene.camera, width, height, jitter)
-        origins, dirs = cache["rays"]
-        return origins[r0:r1].reshape(-1, 3), dirs[r0:r1].reshape(-1, 3)
+            cache["jitter"] = np.zeros((0, 0, 2)) if jitter is None else jitter
+        jitter = cache["jitter"]
+        tile = jitter if len(jitter) == 0 else np.ascontiguousarray(jitter[r0:r1])
+        return kernels.camera_rays(eye, forward, right, up, tan_half, width, height, r0, r1,
+                                   tile)
 
     return rays
 
