@@ -274,7 +274,8 @@ class Viewer:
         s = self.state
         probe_id = id(s.probe) if s.probe is not None else None
         return (repr(s.scene), size, s.compare, s.diff_enabled, s.diff_pair, s.diff_scale,
-                s.show_wireframe, s.show_normals, s.normal_length, probe_id)
+                s.show_wireframe, s.show_normals, s.normal_length, probe_id, id(s.ray_tree),
+                s.show_radiosity and id(s.radiosity_soup))
 
     def unchanged(self, size: tuple[int, int]) -> bool:
         """True when the last image is still right (idle frames only redraw the GUI)."""
@@ -291,8 +292,14 @@ class Viewer:
         if "main" in vp.panes and self.unchanged(size):
             self._handle_click(self._image_with_input(vp.panes["main"].display, size), size)
             return
-        # --- PASS 1-2: the scene into the float target (the Renderer's passes)
-        pane = vp.draw_scene("main", scene, size, scene.render.shading, scene.render.specular)
+        # --- PASS 1-2: the scene into the float target (the Renderer's passes), or the solved
+        # radiosity meshes, Gouraud-interpolated (view-independent: walk around them)
+        radiosity = state.show_radiosity and state.radiosity_soup is not None
+        if radiosity:
+            pane = vp.pane("main", size)
+            vp.draw_colored_triangles(pane, scene, state.radiosity_soup)
+        else:
+            pane = vp.draw_scene("main", scene, size, scene.render.shading, scene.render.specular)
         # --- PASS 3: the probe reads the GPU value before any overlay is drawn
         if state.probe_requested:
             self.update_probe(size)
@@ -307,6 +314,9 @@ class Viewer:
             length = 0.12 * overlays.scene_diagonal(meshes)
             vp.draw_lines(pane, overlays.probe_arrows(state.probe, length), exposure,
                           depth_test=False)
+        if state.ray_tree is not None:
+            lines = overlays.ray_tree_lines(state.ray_tree, overlays.scene_diagonal(meshes))
+            vp.draw_lines(pane, lines, exposure, depth_test=False)
         # --- PASS 5: exposure + sRGB for display
         texture = vp.present(pane, exposure)
         if state.screenshot_requested:
@@ -344,7 +354,7 @@ class Viewer:
             return  # (kept requested: the layout may still be settling)
         state.probe_requested = False
         result = probe(state.scene, size, pixel)
-        if result is not None:
+        if result is not None and not state.show_radiosity:
             result.gpu = self.viewport.read_pixel("main", pixel)
         state.probe = result
         if result is None:

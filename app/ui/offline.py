@@ -42,6 +42,8 @@ def start_job(state: AppState, index: int) -> None:
         state.job_raster = state.gl.read_linear("job_raster")
         state.gl.restore()
     state.job_kind, state.job_version, state.job_compare = index, -1, None
+    state.job_scene, state.job_size_px = scene, size
+    state.ray_tree = state.ray_tree_pixel = None
     state.job.start(kind.label, lambda: kind.make(scene, size))
 
 
@@ -76,17 +78,78 @@ def _upload_results(state: AppState) -> None:
         scale = max(float(np.abs(raster).max()) * exposure, 1e-6) * 0.1
         vp.upload_image("job_diff", heat_map(image * exposure, raster * exposure, scale))
         state.job_compare = difference(image, raster) | {"heat_full_scale": scale / exposure}
+    solution = latest.stats.get("solution") if latest.stats else None
+    if solution is not None and hasattr(solution, "display_meshes"):
+        from app.ui.overlays import radiosity_soup
+
+        state.radiosity_soup = radiosity_soup(solution.display_meshes())
 
 
-def _show(state: AppState, key: str, caption: str, width: float) -> None:
+def _show(state: AppState, key: str, caption: str, width: float) -> tuple[int, int] | None:
+    """Show an uploaded image; returns the image pixel clicked, if any."""
     tex = state.gl.images.get(key)
     if tex is None:
-        return
+        return None
     w, h = tex.size
     imgui.begin_group()
+    origin = imgui.get_cursor_screen_pos()
     imgui.image(imgui.ImTextureRef(tex.glo), imgui.ImVec2(width, width * h / w))
+    clicked = None
+    if imgui.is_item_clicked():
+        mouse = imgui.get_io().mouse_pos
+        x, y = int((mouse.x - origin.x) * w / width), int((mouse.y - origin.y) * w / width)
+        if 0 <= x < w and 0 <= y < h:
+            clicked = (x, y)
     imgui.text(caption)
     imgui.end_group()
+    return clicked
+
+
+def trace_tree(state: AppState, pixel: tuple[int, int]) -> None:
+    """The ray tree of a pixel of the ray-traced image, drawn in 3D in the viewport."""
+    try:
+        from app.raytrace.tree import trace_pixel_tree
+    except ImportError as exc:
+        state.error = f"ray tree not available ({exc})"
+        return
+    try:
+        state.ray_tree = trace_pixel_tree(state.job_scene, state.job_size_px, *pixel)
+        state.ray_tree_pixel = pixel
+    except Exception as exc:  # shown in the app; the session goes on
+        state.error = f"ray tree of pixel {pixel}: {exc}"
+
+
+def draw_ray_tree(state: AppState) -> None:
+    root = state.ray_tree
+    if root is None:
+        return
+    imgui.text(f"ray tree of pixel {state.ray_tree_pixel} (drawn in the viewport; "
+               f"total {_rgb(root.total())})")
+    if imgui.small_button("Clear ray tree"):
+        state.ray_tree = None
+        return
+    flags = imgui.TableFlags_.borders | imgui.TableFlags_.row_bg | imgui.TableFlags_.scroll_y
+    if imgui.begin_table("raytree", 4, flags, imgui.ImVec2(0, 160)):
+        for head in ("ray", "hit", "weight", "contribution"):
+            imgui.table_setup_column(head)
+        imgui.table_headers_row()
+        for depth, node in root.flatten():
+            imgui.table_next_row()
+            imgui.table_next_column()
+            label = node.kind + (f" L{node.light} S={node.shadow:g}" if node.kind == "shadow"
+                                 else "")
+            imgui.text("  " * depth + label)
+            imgui.table_next_column()
+            imgui.text("miss" if node.end is None else f"object {node.object}")
+            imgui.table_next_column()
+            imgui.text(_rgb(node.weight))
+            imgui.table_next_column()
+            imgui.text(_rgb(node.contribution))
+        imgui.end_table()
+
+
+def _rgb(v) -> str:
+    return "(" + ", ".join(f"{float(c):.3g}" for c in np.asarray(v).reshape(-1)[:3]) + ")"
 
 
 def draw_offline_panel(state: AppState) -> bool:
@@ -127,7 +190,10 @@ def draw_offline_panel(state: AppState) -> bool:
     _upload_results(state)
     width = (imgui.get_content_region_avail().x - 16) / 3
     if "job_result" in state.gl.images and width > 8:
-        _show(state, "job_result", "offline", width)
+        clicked = _show(state, "job_result", "offline (click: ray tree)"
+                        if kind.label.startswith("Whitted") else "offline", width)
+        if clicked is not None and kind.label.startswith("Whitted") and not job.running:
+            trace_tree(state, clicked)
         imgui.same_line()
         _show(state, "job_raster", f"raster ({kind.raster_shading})", width)
         imgui.same_line()
@@ -138,5 +204,12 @@ def draw_offline_panel(state: AppState) -> bool:
                    f"relative RMSE {c['relative_rmse']:.3%}")
         imgui.text_colored(panels.DIM_COLOR, f"heat map: red = {c['heat_full_scale']:.3g}")
     if latest is not None and latest.stats and not job.running:
-        imgui.text_wrapped("  ".join(f"{k}: {v}" for k, v in latest.stats.items()))
+        shown = {k: v for k, v in latest.stats.items()
+                 if isinstance(v, (int, float, str, bool))}
+        imgui.text_wrapped("  ".join(f"{k}: {v:.4g}" if isinstance(v, float) else f"{k}: {v}"
+                                     for k, v in shown.items()))
+    if state.radiosity_soup is not None:
+        _, state.show_radiosity = imgui.checkbox("Show the radiosity solution in the viewport",
+                                                 state.show_radiosity)
+    draw_ray_tree(state)
     return False

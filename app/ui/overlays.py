@@ -81,3 +81,26 @@ def probe_arrows(result, length: float) -> np.ndarray:
         parts.append(arrow(p, term.to_light, length, ARROW_COLORS["L"]))
         parts.append(arrow(p, result.reflected(i), length * 0.8, ARROW_COLORS["R"]))
     return np.concatenate(parts)
+
+
+RAY_COLORS = {"primary": (1.0, 1.0, 1.0), "shadow": (1.0, 0.85, 0.1), "blocked": (1.0, 0.2, 0.2),
+              "reflected": (0.2, 0.9, 1.0), "refracted": (0.3, 1.0, 0.3)}
+
+
+def ray_tree_lines(root, miss_length: float) -> np.ndarray:
+    """Every ray of a ray tree as a segment, colored by kind (blocked shadow rays red)."""
+    parts = []
+    for _, node in root.flatten():
+        end = node.end if node.end is not None else node.origin + miss_length * node.direction
+        kind = "blocked" if node.kind == "shadow" and node.shadow < 1.0 else node.kind
+        parts.append(_segments(np.array([node.origin]), np.array([end]), RAY_COLORS[kind]))
+    return np.concatenate(parts) if parts else np.zeros((0, 6), np.float32)
+
+
+def radiosity_soup(meshes: list) -> np.ndarray:
+    """(3F, 6) float32 position and radiance per corner of radiosity display meshes."""
+    parts = [np.concatenate([np.asarray(v)[f].reshape(-1, 3), np.asarray(c)[f].reshape(-1, 3)],
+                            axis=1) for v, f, c in meshes if len(f)]
+    if not parts:
+        return np.zeros((0, 6), np.float32)
+    return np.ascontiguousarray(np.concatenate(parts), dtype=np.float32)

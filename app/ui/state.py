@@ -149,6 +149,12 @@ class AppState:
     job_kinds: Any = None             # app.ui.jobs.available_jobs(), found on first use
     job_version: int = -1             # the JobRunner version last uploaded
     gl: Any = None                    # app.ui.viewport.Viewport (GL thread only)
+    job_scene: Any = None             # the Scene snapshot the last job rendered
+    job_size_px: tuple = (0, 0)       # its image size (width, height)
+    ray_tree: Any = None              # app.raytrace.tree.RayNode of a clicked traced pixel
+    ray_tree_pixel: Any = None        # (x, y) in the job image
+    radiosity_soup: Any = None        # (3F, 6) float32 solved display triangles (radiance)
+    show_radiosity: bool = False      # draw the radiosity solution instead of the raster
 
     @classmethod
     def from_scene(cls, scene: Scene, source: str, **kwargs) -> "AppState":

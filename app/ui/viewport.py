@@ -88,8 +88,18 @@ class Viewport:
         pane.view = self.renderer.render(scene, pane.target, shading, specular)
         return pane
 
+    def draw_colored_triangles(self, pane: Pane, scene: Scene, soup: np.ndarray) -> None:
+        """Per-vertex radiance triangles (a radiosity solution), Gouraud-interpolated."""
+        from app.geometry.mesh import scene_meshes
+        from app.render.renderer import make_view
+
+        pane.view = make_view(scene, pane.size, scene_meshes(scene))
+        pane.target.clear(scene.render.background)
+        self.draw_lines(pane, soup, 1.0, depth_test=True, mode=moderngl.TRIANGLES, bias=0.0)
+
     def draw_lines(self, pane: Pane, lines: np.ndarray, exposure: float,
-                   depth_test: bool = True) -> None:
+                   depth_test: bool = True, mode: int = moderngl.LINES,
+                   bias: float = LINE_DEPTH_BIAS) -> None:
         """Overlay colored segments (wireframe, glyphs, arrows) onto the float target."""
         if len(lines) == 0 or pane.view is None:
             return
@@ -101,9 +111,9 @@ class Viewport:
         self.ctx.enable_only(moderngl.DEPTH_TEST if depth_test else moderngl.NOTHING)
         program = self.lines_program
         set_uniform(program, "u_clip_from_world", gl_matrix(pane.view.clip_from_world))
-        set_uniform(program, "u_depth_bias", LINE_DEPTH_BIAS if depth_test else 0.0)
+        set_uniform(program, "u_depth_bias", bias if depth_test else 0.0)
         set_uniform(program, "u_scale", 1.0 / max(exposure, 1e-12))
-        self._line_vao.render(moderngl.LINES, vertices=len(lines))
+        self._line_vao.render(mode, vertices=len(lines))
 
     def present(self, pane: Pane, exposure: float, source: Pane | None = None,
                 other: Pane | None = None, diff_scale: float = 0.05) -> moderngl.Texture:
