@@ -43,6 +43,9 @@ class ViewerOptions:
     job: str = ""                         # offline job started at start (label prefix)
     bench_json: str = ""                  # frame times written here at exit
     autosave: bool = True
+    show_radiosity: bool = False          # once a radiosity job ends, show its solution
+    ray_tree: tuple[int, int] | None = None  # once a Whitted job ends, trace this pixel's tree
+    focus: str = ""                       # dock window brought to front at start
     test_function: Callable | None = None  # immapp.testing test body (GUI tests)
 
 
@@ -195,6 +198,7 @@ class Viewer:
     redrawn: bool = False              # this frame re-rendered the scene
     redraw_flags: list = field(default_factory=list)
     cpu_times: list = field(default_factory=list)
+    _job_followed_up: bool = False
 
     # ------------------------------------------------------------ GL lifetime
     def post_init(self) -> None:
@@ -205,6 +209,10 @@ class Viewer:
         self.state.gl = self.viewport
         if self.options.probe is not None:
             self.state.probe_pixel, self.state.probe_requested = self.options.probe, True
+        if self.options.focus:
+            for window in hello_imgui.get_runner_params().docking_params.dockable_windows:
+                if window.label.lower().startswith(self.options.focus.lower()):
+                    window.focus_window_at_next_frame = True
         if self.options.job:
             from app.ui.offline import start_job_by_label
 
@@ -466,9 +474,23 @@ class Viewer:
         state.frame += 1
         if self.options.bench_json and self.options.frames:
             self.force_redraw = state.frame >= self.options.frames // 2
-        waiting = self.options.job and (state.job.running or not state.job.started)
+        waiting = self.options.job and (state.job.running or not state.job.started
+                                        or state.job_version != state.job.version)
+        if self.options.job and not waiting and not self._job_followed_up:
+            self._job_followed_up = True
+            self.follow_up_job()
         if self.options.frames and state.frame >= self.options.frames and not waiting:
             hello_imgui.get_runner_params().app_shall_exit = True
+
+    def follow_up_job(self) -> None:
+        """The command line's after-job requests: radiosity in the viewport, a ray tree."""
+        state = self.state
+        if self.options.show_radiosity and state.radiosity_soup is not None:
+            state.show_radiosity = True
+        if self.options.ray_tree is not None and state.job_scene is not None:
+            from app.ui.offline import trace_tree
+
+            trace_tree(state, self.options.ray_tree)
 
     def autosave(self, force: bool = False) -> None:
         state = self.state
@@ -542,7 +564,7 @@ def _docking(viewer: Viewer) -> hello_imgui.DockingParams:
     params = hello_imgui.DockingParams()
     params.docking_splits = [
         split("MainDockSpace", "LeftSpace", imgui.Dir.left, 0.24),
-        split("MainDockSpace", "RightSpace", imgui.Dir.right, 0.34),
+        split("MainDockSpace", "RightSpace", imgui.Dir.right, 0.36),
         split("RightSpace", "RightBottom", imgui.Dir.down, 0.45),
     ]
     p = viewer.panel

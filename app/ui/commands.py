@@ -30,6 +30,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--job", metavar="NAME", help="start this offline render at start "
                    "(e.g. 'reference', 'whitted', 'path', 'radiosity'); --frames counts "
                    "after it ends")
+    p.add_argument("--show-radiosity", action="store_true",
+                   help="with --job radiosity: draw the solution in the viewport when done")
+    p.add_argument("--ray-tree", metavar="X,Y",
+                   help="with --job whitted: draw the ray tree of this pixel of its image")
+    p.add_argument("--focus", metavar="PANEL", help="bring this panel's tab to the front "
+                   "(Scene, Lights, Materials, Objects)")
     p.add_argument("--presenter", action="store_true", help="large fonts for a projector")
     p.add_argument("--wireframe", action="store_true", help="show the wireframe")
     p.add_argument("--normals", action="store_true", help="show normal glyphs")
@@ -39,14 +45,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(run=run_view)
 
 
-def _pixel(text: str) -> tuple[int, int]:
+def _pixel(text: str, flag: str) -> tuple[int, int]:
     try:
         x, y = (int(v) for v in text.split(","))
     except ValueError:
-        raise ShadeLabError(f"--probe '{text}': expected X,Y viewport pixel, e.g. 300,200") \
-            from None
+        raise ShadeLabError(f"{flag} '{text}': expected an X,Y pixel, e.g. 300,200") from None
     if x < 0 or y < 0:
-        raise ShadeLabError(f"--probe '{text}': expected non-negative pixel coordinates")
+        raise ShadeLabError(f"{flag} '{text}': expected non-negative pixel coordinates")
     return x, y
 
 
@@ -72,7 +77,8 @@ def run_view(args: argparse.Namespace) -> int:
 
     window = parse_size(args.window)
     check_writable(args.screenshot, "--screenshot")
-    probe = _pixel(args.probe) if args.probe else None
+    probe = _pixel(args.probe, "--probe") if args.probe else None
+    ray_tree = _pixel(args.ray_tree, "--ray-tree") if args.ray_tree else None
     if args.frames < 0:
         raise ShadeLabError(f"--frames {args.frames}: expected a count >= 0")
     scene, source = load_scene(args)
@@ -88,5 +94,7 @@ def run_view(args: argparse.Namespace) -> int:
     state.show_wireframe, state.show_normals = args.wireframe, args.normals
     options = ViewerOptions(frames=args.frames, screenshot=args.screenshot or "",
                             window_size=window, probe=probe, job=args.job or "",
-                            bench_json=args.bench_json or "", autosave=not args.no_autosave)
+                            bench_json=args.bench_json or "", autosave=not args.no_autosave,
+                            show_radiosity=args.show_radiosity, ray_tree=ray_tree,
+                            focus=args.focus or "")
     return run_viewer(state, options)

@@ -65,9 +65,12 @@ def _job_size(state: AppState) -> tuple[int, int]:
 def _upload_results(state: AppState) -> None:
     """Re-upload the job's image, its raster partner and their difference when new."""
     latest, version = state.job.snapshot()
-    if latest is None or latest.image is None or version == state.job_version:
+    if latest is None or version == state.job_version:
         return
     state.job_version = version
+    _take_solution(state, latest)
+    if latest.image is None:
+        return
     exposure = state.scene.render.exposure
     image = np.asarray(latest.image, dtype=np.float32)
     vp = state.gl
@@ -78,6 +81,10 @@ def _upload_results(state: AppState) -> None:
         scale = max(float(np.abs(raster).max()) * exposure, 1e-6) * 0.1
         vp.upload_image("job_diff", heat_map(image * exposure, raster * exposure, scale))
         state.job_compare = difference(image, raster) | {"heat_full_scale": scale / exposure}
+
+
+def _take_solution(state: AppState, latest) -> None:
+    """Keep a radiosity solution's display triangles (drawn in the viewport on request)."""
     solution = latest.stats.get("solution") if latest.stats else None
     if solution is not None and hasattr(solution, "display_meshes"):
         from app.ui.overlays import radiosity_soup

@@ -180,23 +180,25 @@ def _light_rows(light: Light, span: float) -> list[tuple]:
 
 
 def attenuation_curve(state: AppState, light: Light, samples: int = 200):
-    """Distances from the light across the scene's bounding box, and f_att there."""
-    from app.geometry.mesh import scene_bounds, scene_meshes
+    """f_att over the distances from the light to the scene's surfaces (vertex distances)."""
+    from app.geometry.mesh import scene_meshes
 
-    lo, hi = scene_bounds(scene_meshes(state.scene))
-    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
-                        for z in (lo[2], hi[2])])
-    far = float(np.linalg.norm(corners - np.asarray(light.position), axis=1).max())
-    d = np.linspace(far / samples, far, samples)
+    points = np.concatenate([m.vertices for m in scene_meshes(state.scene)])
+    distances = np.linalg.norm(points - np.asarray(light.position), axis=1)
+    far = float(distances.max()) if len(distances) else 1.0
+    near = max(float(distances.min()) if len(distances) else 0.0, 0.02 * far)
+    d = np.linspace(near, far, samples)
     f = reference.attenuation(d, light.attenuation, light.c1, light.c2, light.c3)
     return d, np.asarray(f, dtype=np.float64)
 
 
 def _draw_attenuation_plot(state: AppState, index: int, light: Light) -> None:
     d, f = attenuation_curve(state, light)
-    if implot.begin_plot(f"f_att(d)##{index}", imgui.ImVec2(-1, 160)):
+    if implot.begin_plot(f"f_att(d)##{index}", imgui.ImVec2(-1, 170)):
         implot.setup_axes("d (scene units)", "f_att",
                           implot.AxisFlags_.auto_fit, implot.AxisFlags_.auto_fit)
+        if light.attenuation == "inverse_square":
+            implot.setup_axis_scale(implot.ImAxis_.y1, implot.Scale_.log10)
         implot.plot_line("f_att", d, f)
         probe = state.probe
         if probe is not None and index < len(probe.terms.lights):
@@ -300,11 +302,11 @@ EQUATION = "I = Le + Ia ka Od + sum_i S_i f_att,i Ip,i [kd Od (N.L_i) + ks Os (R
 EQUATION_BLINN = "I = Le + Ia ka Od + sum_i S_i f_att,i Ip,i [kd Od (N.L_i) + ks Os (N.H_i)^n]"
 
 
-def _rgb(v) -> str:
-    return "(" + ", ".join(f"{float(c):.4g}" for c in np.asarray(v).reshape(-1)[:3]) + ")"
+def _rgb(v, digits: int = 3) -> str:
+    return "(" + ", ".join(f"{float(c):.{digits}g}" for c in np.asarray(v).reshape(-1)[:3]) + ")"
 
 
-def _term_row(label: str, value, note: str = "") -> None:
+def _term_row(label: str, value) -> None:
     imgui.table_next_row()
     imgui.table_next_column()
     imgui.text(label)
@@ -312,9 +314,7 @@ def _term_row(label: str, value, note: str = "") -> None:
     for c in range(3):
         imgui.table_next_column()
         if c < len(values):
-            imgui.text(f"{values[c]:.5g}")
-    imgui.table_next_column()
-    imgui.text(note)
+            imgui.text(f"{values[c]:.4g}")
 
 
 def draw_equation_panel(state: AppState) -> bool:
@@ -337,27 +337,28 @@ def draw_equation_panel(state: AppState) -> bool:
     imgui.text(f"pixel {result.pixel}  object {result.hit.mesh.index} "
                f"({scene.objects[result.hit.mesh.index].name or 'unnamed'}), material "
                f"'{result.hit.mesh.material}'")
-    imgui.text(f"P = {_rgb(result.point)}  N = {_rgb(result.normal)}  V = {_rgb(result.to_eye)}")
+    imgui.text(f"P = {_rgb(result.point, 4)}  N = {_rgb(result.normal)}")
+    imgui.text(f"V = {_rgb(result.to_eye)}")
     imgui.text(f"ka {m.ka:.3g}  kd {m.kd:.3g}  ks {m.ks:.3g}  n {m.n:.3g}  "
                f"Od {_rgb(m.Od)}  Os {_rgb(m.Os)}")
+    imgui.text_colored(DIM_COLOR, "arrows: N white, V cyan, L_i yellow, "
+                       + ("H_i" if blinn else "R_i") + " magenta")
+    lights = scene.active_lights()
     flags = (imgui.TableFlags_.borders | imgui.TableFlags_.row_bg
              | imgui.TableFlags_.sizing_fixed_fit)
-    if imgui.begin_table("terms", 5, flags):
-        for head in ("term", "R", "G", "B", ""):
+    if imgui.begin_table("terms", 4, flags):
+        for head in ("term", "R", "G", "B"):
             imgui.table_setup_column(head)
         imgui.table_headers_row()
         terms = result.terms
         _term_row("Le (emission)", terms.emission)
         _term_row("ambient Ia ka Od", terms.ambient)
-        lights = scene.active_lights()
         for i, t in enumerate(terms.lights):
             name = lights[i].name or f"light {i}"
             n_dot_l = float(np.dot(result.normal, t.to_light))
             spec_cos = float(np.dot(result.normal if blinn else result.reflected(i),
                                     result.reflected(i) if blinn else result.to_eye))
-            clamp = "clamp min(.,1) ACTIVE" if bool(t.clamp_active) else "clamp off"
-            _term_row(f"{name}: f_att", float(t.f_att),
-                      f"d = {float(t.distance):.4g}, {clamp}")
+            _term_row(f"{name}: d, f_att", (float(t.distance), float(t.f_att)))
             _term_row(f"{name}: S_i, spot", (float(t.shadow), float(t.spot)))
             _term_row(f"{name}: N.L, {'N.H' if blinn else 'R.V'}", (n_dot_l, spec_cos))
             _term_row(f"{name}: diffuse", t.diffuse)
@@ -367,10 +368,17 @@ def draw_equation_panel(state: AppState) -> bool:
         _term_row(f"I ({result.shading} reference)", result.reference)
         if result.gpu is not None:
             _term_row("GPU drew", result.gpu)
-            err = float(np.max(np.abs(result.gpu - result.reference)))
-            _term_row("|GPU - reference|", err, "agree" if err <= 1e-3 * max(
-                1.0, float(np.max(result.reference))) else "DIFFER")
         imgui.end_table()
+    for i, t in enumerate(result.terms.lights):
+        if lights[i].attenuation == "lecture":
+            imgui.text(f"{lights[i].name or f'light {i}'}: min(1/(c1 + c2 d + c3 d^2), 1) clamp "
+                       + ("ACTIVE (f_att = 1)" if bool(t.clamp_active) else "not active"))
+    if result.gpu is not None:
+        err = float(np.max(np.abs(result.gpu - result.reference)))
+        agree = err <= 1e-4 * max(1.0, float(np.max(np.abs(result.reference))))
+        imgui.text_colored(OK_COLOR if agree else ERROR_COLOR,
+                           f"GPU vs numpy reference: max |diff| {err:.2g} "
+                           + ("(agree)" if agree else "(DIFFER)"))
     if result.shading != "phong":
         imgui.text_wrapped(f"{SHADING_LABELS[result.shading]} shading: the terms above are at "
                            "the probed point; the pixel's I is "
