@@ -121,17 +121,24 @@ def _tiny_scene(material: Material, light_list: list[Light], Ia, quad=None) -> S
 
 
 @pytest.mark.gl
-@settings(max_examples=15, deadline=None,
+@settings(max_examples=12, deadline=None,
           suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(material=materials(), light_list=st.lists(lights(), min_size=1, max_size=3), Ia=rgb,
        shading=st.sampled_from(["flat", "gouraud", "phong"]),
        specular=st.sampled_from(["phong", "blinn"]),
-       quad=st.lists(st.tuples(*[st.integers(-1, 1).map(float)] * 3), min_size=4, max_size=4))
+       quad=st.lists(st.tuples(*[st.integers(-1, 1).map(float)] * 3), min_size=4, max_size=4),
+       passes=st.sampled_from([("none", "zfail", "zbuffer"), ("volumes", "zfail", "zbuffer"),
+                               ("volumes", "zpass", "zbuffer"), ("none", "zfail", "painter")]),
+       kt=st.sampled_from([0.0, 0.5, 1.0]))
 def test04_raster_is_finite_and_non_negative(gl_ctx, material, light_list, Ia, shading,
-                                              specular, quad):
+                                              specular, quad, passes, kt):
     from app.render.offscreen import render_image
 
     scene = _tiny_scene(material, light_list, Ia, quad)    # the quad is often degenerate
+    scene.render.shadows, scene.render.shadow_method, scene.render.visibility = passes
+    scene.materials["glass"] = Material(kt=kt, ka=0.1, kd=0.5, Od=(0.2, 0.6, 0.9))
+    scene.objects.append(Object(shape="box", material="glass", extents=(0.5, 0.5, 0.5),
+                                translate=(0.8, 0.0, 1.0)))   # transparent when kt > 0
     image = render_image(scene, (16, 12), shading, specular)
     _assert_clean(image, f"raster {shading}")
 
