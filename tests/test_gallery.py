@@ -285,8 +285,12 @@ def test17_gallery_command_writes_pngs(gl_ctx, tmp_path, capsys):
                  "--only", "gouraud-highlight", "--only", "intensity-zero"]) == 0
     assert sorted(p.name for p in out.iterdir()) == ["gouraud-highlight.png",
                                                      "intensity-zero.png"]
-    assert main(["gallery", "--only", "nope", "--out", str(out)]) == 2
-    assert capsys.readouterr().err.count("\n") == 1
+    for bad in (["--only", "nope"], ["--size", "0x5"], ["--size", "big"]):
+        assert main(["gallery", *bad, "--out", str(out)]) == 2
+        assert capsys.readouterr().err.count("\n") == 1
+    (tmp_path / "file").write_text("x")
+    assert main(["gallery", "--out", str(tmp_path / "file" / "sub")]) == 2
+    assert "cannot create folder" in capsys.readouterr().err
 
 
 def test18_skipped_case_reports_why():
