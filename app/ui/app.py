@@ -371,7 +371,11 @@ class Viewer:
     def draw_compare(self, size: tuple[int, int]) -> None:
         state, vp = self.state, self.viewport
         scene = state.scene
-        half = (max(size[0] // 2, 8), max(size[1] // 2, 8))
+        # Four quadrants; with the heat map, the map takes 70% of the width at full height.
+        if state.diff_enabled:
+            half = (max(int(size[0] * 0.7), 8), max(size[1], 8))
+        else:
+            half = (max(size[0] // 2, 8), max(size[1] // 2, 8))
         exposure = scene.render.exposure
         if "compare3" in vp.panes and self.unchanged(size):
             panes = [vp.panes[f"compare{i}"] for i in range(len(COMPARE_VIEWS))]
@@ -391,9 +395,12 @@ class Viewer:
                           f"full red = {state.diff_scale:.3g}")
             imgui.same_line()
             imgui.begin_group()
+            thumb_w = max(size[0] - half[0] - 12, 8)
+            thumb_h = min(thumb_w * half[1] / half[0], size[1] / 2 - 30)
             for i in (a, b):
                 tex = vp.present(panes[i], exposure)
-                imgui.image(imgui.ImTextureRef(tex.glo), imgui.ImVec2(half[0] // 2, half[1] // 2),
+                imgui.image(imgui.ImTextureRef(tex.glo),
+                            imgui.ImVec2(thumb_h * half[0] / half[1], thumb_h),
                             uv0=imgui.ImVec2(0, 1), uv1=imgui.ImVec2(1, 0))
                 imgui.text(COMPARE_LABELS[i])
             imgui.end_group()

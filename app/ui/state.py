@@ -119,7 +119,7 @@ class AppState:
     compare: bool = False
     diff_enabled: bool = False
     diff_pair: tuple[int, int] = (0, 2)   # indices into COMPARE_VIEWS
-    diff_scale: float = 0.05          # heat map: this difference is full red
+    diff_scale: float = 0.2           # heat map: this difference (x exposure) is full red
     presenter: bool = False
     show_help: bool = False
     legend_in_screenshot: bool = True
