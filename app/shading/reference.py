@@ -116,7 +116,9 @@ def attenuation_clamped(distance: np.ndarray, light: Light) -> np.ndarray:
     if light.attenuation != "lecture":
         return np.zeros(np.shape(distance), dtype=bool)
     d = np.asarray(distance, dtype=np.float64)
-    return (light.c1 + light.c2 * d + light.c3 * d * d) <= 1.0
+    finite = np.isfinite(d)
+    dd = np.where(finite, d, 0.0)
+    return finite & ((light.c1 + light.c2 * dd + light.c3 * dd * dd) <= 1.0)
 
 
 def spot_factor(to_light: np.ndarray, axis: np.ndarray, cos_cone: float,
