@@ -13,6 +13,7 @@ from app.geometry.mesh import scene_meshes
 from app.gl.context import headless_context
 from app.gl.programs import load_program
 from app.gl.target import RenderTarget
+from app.radiosity.hemicube_gl import rebind
 from app.render.renderer import make_view
 from app.scene.camera import gl_matrix
 from app.scene.model import Scene
@@ -38,6 +39,7 @@ def render_meshes(scene: Scene, meshes: list, size: tuple[int, int],
     target = RenderTarget(ctx, size)
     vbo = ctx.buffer(triangle_soup(meshes).tobytes())
     vao = ctx.vertex_array(program, [(vbo, "3f 3f", "in_position", "in_radiance")])
+    previous = ctx.fbo  # bound again afterwards: nobody is left on a released fbo
     try:
         # --- PASS 1: clear to the background
         target.clear(scene.render.background)
@@ -47,6 +49,7 @@ def render_meshes(scene: Scene, meshes: list, size: tuple[int, int],
         vao.render(moderngl.TRIANGLES)
         return target.read()
     finally:
+        rebind(ctx, previous)
         vao.release()
         vbo.release()
         target.release()

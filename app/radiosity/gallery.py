@@ -90,7 +90,7 @@ def hidden_floor_radiosity(solution: RadiositySolution, footprint=BLOCK_FOOTPRIN
     return float((overlap * luminance).sum() / area)
 
 
-def light_leak(count: int = 60, method: str = "raycast") -> dict:
+def light_leak(count: int = 40, method: str = "raycast") -> dict:
     """Hidden-floor radiance with the floor unsplit and split along the block's base."""
     scene = load_preset("radiosity-leak")
     out = {}

@@ -39,6 +39,15 @@ def _view(eye: np.ndarray, forward: np.ndarray, up: np.ndarray) -> np.ndarray:
     return m
 
 
+def rebind(ctx: moderngl.Context, previous) -> None:
+    """Bind ``previous`` again (or the default framebuffer if it is gone), so that a later
+    ``ctx.framebuffer(...)`` does not try to restore a released one (GL_INVALID_OPERATION)."""
+    if previous is not None and type(previous.mglo).__name__ != "InvalidObject":
+        previous.use()
+    else:
+        ctx.detect_framebuffer(0).use()
+
+
 def tangent_frame(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Two unit vectors t, b with (t, b, n) right-handed and orthonormal."""
     helper = np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
@@ -111,6 +120,7 @@ class Hemicube:
         Row 0 of each strip is the top of the image: for side faces, nearest the normal.
         """
         ctx, res = self.ctx, self.res
+        previous = ctx.fbo  # bound again afterwards: nobody is left on a released fbo
         self.fbo.use()
         self.fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         ctx.enable_only(moderngl.DEPTH_TEST)
@@ -122,6 +132,7 @@ class Hemicube:
                 self.vao.render(moderngl.TRIANGLES)
         self.fbo.viewport = (0, 0, *self.fbo.size)
         raw = np.frombuffer(self.color.read(alignment=1), dtype=np.uint32)
+        rebind(ctx, previous)
         atlas = raw.reshape(self.batch * res, 5 * res)[::-1]
         return atlas.reshape(self.batch, res, 5 * res)[:len(indices)]
 

@@ -55,10 +55,19 @@ class RadiositySolution:
         """(vertices (V,3), faces (F,3), vertex_radiance (V,3)) per surface, world space."""
         return display.display_meshes(self.patches, self.radiance, conforming)
 
-    def image(self, size: tuple[int, int], conforming: bool = True) -> np.ndarray:
+    def image(self, size: tuple[int, int], conforming: bool = True,
+              supersample: int = 1) -> np.ndarray:
         """CPU image (H, W, 3) float32 radiance from the scene camera (embreex primary rays,
-        pixel centres like the rasterizer); GL-free, for the viewer's side panel."""
-        return cpu_image(self.scene, self.display_meshes(conforming), size)
+        pixel centres like the rasterizer); GL-free, for the viewer's side panel.
+
+        ``supersample`` = s averages s x s sub-pixel centres (a box filter, like the path
+        tracer's jittered samples), for comparisons with it.
+        """
+        s = max(1, int(supersample))
+        image = cpu_image(self.scene, self.display_meshes(conforming), (size[0] * s, size[1] * s))
+        if s == 1:
+            return image
+        return image.reshape(size[1], s, size[0], s, 3).mean(axis=(1, 3)).astype(np.float32)
 
 
 # ---------------------------------------------------------------------- checks
