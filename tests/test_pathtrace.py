@@ -118,6 +118,14 @@ def test_same_seed_same_image_other_seed_differs():
     assert np.abs(a - c).max() > 0
 
 
+def test_two_worker_processes_give_the_same_image():
+    scene = load_preset("cornell")
+    size = (16, 2048)  # 2 tiles per pass
+    serial = render_pathtraced(scene, size, 2, seed=3)
+    pooled = render_pathtraced(scene, size, 2, seed=3, workers=2)
+    np.testing.assert_array_equal(serial, pooled)
+
+
 def test_cli_pathtrace_writes_radiance(tmp_path):
     npy = tmp_path / "p.npy"
     code = main(["pathtrace", "cornell", "-o", str(tmp_path / "p.png"), "--size", "16x12",

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 
 import numpy as np
@@ -14,7 +13,6 @@ from app.raytrace.accel import BACKENDS
 from app.scene.preset import load_preset
 
 MAX_DEPTH = 64
-POOL_MIN_RAYS = 1_000_000  # primary rays from which a 2-process pool pays for its start-up
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -29,9 +27,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--error", type=float, metavar="BUDGET",
                    help="auto quality: the cheapest depth and spp within this relative MSE "
                         "(e.g. 0.01; see app.studies.autoquality)")
-    p.add_argument("--workers", type=int, metavar="N",
-                   help="processes tracing tiles (default: 2 for jobs of 1M+ primary rays, "
-                        "else 1; each costs a second or two to start)")
+    p.add_argument("--workers", type=int, default=1, metavar="N",
+                   help="processes tracing tiles in parallel (default 1; 2 uses both cores "
+                        "of an idle machine, each worker takes a second or two to start)")
     p.set_defaults(run=run_raytrace)
 
     p = sub.add_parser("pathtrace", help="Monte Carlo path tracing (reference radiance)")
@@ -40,6 +38,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=int, default=0, help="random seed")
     p.add_argument("--backend", choices=BACKENDS, default="auto",
                    help="ray casting: embree (embreex) or the numba BVH")
+    p.add_argument("--workers", type=int, default=1, metavar="N",
+                   help="processes tracing tiles in parallel (default 1)")
     p.set_defaults(run=run_pathtrace)
 
 
@@ -85,13 +85,8 @@ def run_raytrace(args: argparse.Namespace) -> int:
         args.depth, args.spp, line = auto_raytrace(scene, size, args.error)
         print(line)
 
-    workers = args.workers
-    if workers is None:
-        spp = scene.raytrace.spp if args.spp is None else args.spp
-        big = size[0] * size[1] * spp >= POOL_MIN_RAYS
-        workers = min(2, os.cpu_count() or 1) if big else 1
     last = run_to_end(iter_raytrace(scene, size, args.depth, args.spp, args.fresnel,
-                                    args.backend, workers=workers), desc="raytrace")
+                                    args.backend, workers=args.workers), desc="raytrace")
     save_outputs(args, last.image, scene.render.exposure)
     _note_if_nothing_visible(last.stats)
     s = last.stats
@@ -103,7 +98,7 @@ def run_raytrace(args: argparse.Namespace) -> int:
 
 def run_pathtrace(args: argparse.Namespace) -> int:
     size = parse_size(args.size)
-    _check_counts(None, args.spp)
+    _check_counts(None, args.spp, args.workers)
     scene = load_preset(args.preset, list(args.set))
     _check_scene(scene, args.preset)
     emitters = [o for o in scene.objects
@@ -115,8 +110,8 @@ def run_pathtrace(args: argparse.Namespace) -> int:
     from app.progress import run_to_end
     from app.raytrace.pathtrace import iter_pathtrace
 
-    last = run_to_end(iter_pathtrace(scene, size, args.spp, args.seed, args.backend),
-                      desc="pathtrace")
+    last = run_to_end(iter_pathtrace(scene, size, args.spp, args.seed, args.backend,
+                                     workers=args.workers), desc="pathtrace")
     save_outputs(args, last.image, scene.render.exposure)
     _note_if_nothing_visible(last.stats)
     s = last.stats

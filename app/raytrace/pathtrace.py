@@ -24,6 +24,7 @@ Estimator (per path vertex, all paths of a bounce as one numpy batch, rays cast 
 
 from __future__ import annotations
 
+import math
 import time
 from typing import Iterator
 
@@ -32,10 +33,9 @@ import numpy as np
 from app.errors import ShadeLabError
 from app.progress import Progress
 from app.raytrace import kernels
-from app.raytrace.accel import Hits
+from app.raytrace.accel import Hits, embree_available
 from app.raytrace.surface import TraceContext, reflect_refract
 from app.raytrace.whitted import stratified_jitter
-from app.scene.camera import primary_rays
 from app.scene.model import Scene
 
 TILE_PATHS = 16384    # paths per work unit (one chunk of the generator)
@@ -109,6 +109,7 @@ class PathTracer:
         self.emission = np.array([m.emission for m in mats], float).reshape(-1, 3)
         self.emitters = Emitters(self.ctx, self.emission)
         self.rays = 0  # counter of rays cast (paths and shadow rays)
+        self.primary_hits = 0  # counter of camera rays that hit something
 
     def radiance(self, origins: np.ndarray, dirs: np.ndarray,
                  rng: np.random.Generator) -> np.ndarray:
@@ -128,6 +129,8 @@ class PathTracer:
                 break
             hits = ctx.accel.intersect(o, d)
             self.rays += len(o)
+            if bounce == 0:
+                self.primary_hits += int(hits.hit.sum())
             miss = ~hits.hit
             _add(out, pixel[miss], beta[miss] * ctx.background)
             keep = np.flatnonzero(hits.hit)
@@ -165,6 +168,8 @@ class PathTracer:
                 break
             hits = ctx.accel.intersect(o, d)
             self.rays += len(o)
+            if bounce == 0:
+                self.primary_hits += int(hits.hit.sum())
             miss = ~hits.hit
             kernels.add_rows(out, pixel, beta * ctx.background, miss)
             keep = np.flatnonzero(hits.hit)
@@ -283,53 +288,108 @@ def _add(out: np.ndarray, pixel: np.ndarray, value: np.ndarray) -> None:
 
 
 def iter_pathtrace(scene: Scene, size: tuple[int, int], spp: int, seed: int = 0,
-                   backend: str = "auto", local: str = "numba") -> Iterator[Progress]:
+                   backend: str = "auto", local: str = "numba",
+                   workers: int = 1) -> Iterator[Progress]:
     """Path-trace progressively: one :class:`Progress` per tile of rows per sample pass.
 
     The image in each Progress is the mean over the samples each pixel has so far
-    (radiance, float32, row 0 at the top); stats hold samples/s and rays/s.
+    (radiance, float32, row 0 at the top); stats hold samples/s and rays/s. Each tile of
+    each pass draws from its own random stream (``seed``, pass, first row), so the image
+    is the same for any number of ``workers`` (processes; 1 traces here).
     """
     width, height = size
     if width < 1 or height < 1:
         raise ShadeLabError(f"--size {width}x{height}: expected each side >= 1")
     if spp < 1:
         raise ShadeLabError(f"--spp {spp}: expected an integer >= 1")
-    tracer = PathTracer(scene, backend, local=local)
-    total = np.zeros((height * width, 3))
-    count = np.zeros(height * width)
     rows = max(1, TILE_PATHS // width)
     tiles = [(r, min(r + rows, height)) for r in range(0, height, rows)]
-    hits = 0
+    jobs = [(sample, r0, r1) for sample in range(spp) for r0, r1 in tiles]
+    setup = (scene, size, spp, seed, backend, local)
+    if workers > 1 and len(jobs) > 1:
+        from app.raytrace.pool import traced_in_pool
+
+        results = traced_in_pool(_init_worker, setup, _trace_tile, jobs, lambda job: job,
+                                 workers)
+        name = "embree" if backend == "embree" or (backend == "auto" and embree_available()) \
+            else "bvh"
+    else:
+        job_fn = TileJob(*setup)
+        results = ((job, job_fn(*job)) for job in jobs)
+        name = job_fn.tracer.ctx.accel.name
+    total = np.zeros((height * width, 3))
+    count = np.zeros(height * width)
+    image = np.zeros((height, width, 3), np.float32)
+    rays = hits = 0
     start = time.perf_counter()
-    for sample in range(spp):
-        rng = np.random.default_rng([seed, sample])
-        # Stratified pixel positions: sample s jitters inside stratum s (random on top)
-        jitter = (rng.random((height, width, 2)) if spp == 1
-                  else stratified_jitter(spp, sample, (height, width), rng))
-        origins, dirs = primary_rays(scene.camera, width, height, jitter)
-        for t, (r0, r1) in enumerate(tiles):
-            o = origins[r0:r1].reshape(-1, 3)
-            d = dirs[r0:r1].reshape(-1, 3)
-            if sample == 0:
-                hits += int(tracer.ctx.accel.intersect(o, d).hit.sum())
-            total[r0 * width:r1 * width] += tracer.radiance(o, d, rng)
-            count[r0 * width:r1 * width] += 1
-            elapsed = time.perf_counter() - start
-            samples = int(count.sum())
-            image = (total / np.maximum(count, 1)[:, None]).reshape(height, width, 3)
-            stats = {"samples": samples, "seconds": elapsed, "rays": tracer.rays,
-                     "samples_per_s": samples / elapsed if elapsed > 0 else 0.0,
-                     "rays_per_s": tracer.rays / elapsed if elapsed > 0 else 0.0,
-                     "primary_hits": hits if sample > 0 or r1 == height else 1,
-                     "backend": tracer.ctx.accel.name, "spp": spp}
-            yield Progress(image.astype(np.float32), (sample * len(tiles) + t + 1)
-                           / (spp * len(tiles)), f"sample {sample + 1}/{spp}, rows {r1}/{height}",
-                           stats)
+    for done, ((sample, r0, r1), (radiance, tile_rays, tile_hits)) in enumerate(results, 1):
+        rays += tile_rays
+        hits += tile_hits if sample == 0 else 0
+        part = slice(r0 * width, r1 * width)
+        total[part] += radiance
+        count[part] += 1
+        image[r0:r1] = (total[part] / count[part, None]).reshape(r1 - r0, width, 3)
+        elapsed = time.perf_counter() - start
+        samples = int(count.sum())
+        stats = {"samples": samples, "seconds": elapsed, "rays": rays,
+                 "samples_per_s": samples / elapsed if elapsed > 0 else 0.0,
+                 "rays_per_s": rays / elapsed if elapsed > 0 else 0.0,
+                 "primary_hits": hits if done >= len(tiles) else 1,
+                 "backend": name, "spp": spp, "workers": workers}
+        yield Progress(image.copy(), done / len(jobs),
+                       f"sample {sample + 1}/{spp}, rows {r1}/{height}", stats)
 
 
-def render_pathtraced(scene: Scene, size: tuple[int, int], spp: int, seed: int = 0) -> np.ndarray:
-    """Path-traced radiance (H, W, 3) float32, row 0 at the top (Embree where available)."""
+class TileJob:
+    """Traces tile (pass, r0, r1): its jittered camera rays and one path per pixel."""
+
+    def __init__(self, scene: Scene, size: tuple[int, int], spp: int, seed: int,
+                 backend: str, local: str):
+        from app.scene.camera import _basis  # the camera's own frame, so the images align
+
+        self.tracer = PathTracer(scene, backend, local=local)
+        self.size, self.spp, self.seed = size, spp, seed
+        cam = scene.camera
+        self.frame = _basis(cam)
+        self.eye = np.asarray(cam.eye, dtype=np.float64)
+        self.tan_half = math.tan(math.radians(cam.fov_y) / 2.0)
+
+    def __call__(self, sample: int, r0: int, r1: int):
+        """(radiance (n, 3), rays cast, primary hits) of one tile."""
+        width, height = self.size
+        rng = np.random.default_rng([self.seed, sample, r0])
+        # Stratified pixel positions: sample s jitters inside stratum s
+        jitter = (rng.random((r1 - r0, width, 2)) if self.spp == 1
+                  else stratified_jitter(self.spp, sample, (r1 - r0, width), rng))
+        forward, right, up = self.frame
+        o, d = kernels.camera_rays(self.eye, forward, right, up, self.tan_half, width, height,
+                                   r0, r1, jitter)
+        before_rays, before_hits = self.tracer.rays, self.tracer.primary_hits
+        radiance = self.tracer.radiance(o, d, rng)
+        return (radiance, self.tracer.rays - before_rays,
+                self.tracer.primary_hits - before_hits)
+
+
+_WORKER_JOB: TileJob | None = None
+
+
+def _init_worker(*setup) -> None:
+    global _WORKER_JOB
+    _WORKER_JOB = TileJob(*setup)
+
+
+def _trace_tile(sample: int, r0: int, r1: int):
+    return _WORKER_JOB(sample, r0, r1)
+
+
+def render_pathtraced(scene: Scene, size: tuple[int, int], spp: int, seed: int = 0,
+                      workers: int = 1) -> np.ndarray:
+    """Path-traced radiance (H, W, 3) float32, row 0 at the top (Embree where available).
+
+    ``workers`` > 1 traces tiles in that many processes (same image; worth it from about
+    a million samples, each worker takes a second or two to start).
+    """
     last = None
-    for step in iter_pathtrace(scene, size, spp, seed):
+    for step in iter_pathtrace(scene, size, spp, seed, workers=workers):
         last = step
     return last.image

@@ -236,29 +236,13 @@ def _trace_tile(o: np.ndarray, d: np.ndarray, depth: int, fresnel: bool):
 
 def _traced_in_pool(scene: Scene, backend: str, shadows: bool, jobs: list, rays, depth: int,
                     fresnel: bool, workers: int):
-    """Tiles traced by ``workers`` spawned processes, in job order, a few in flight."""
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor
+    """Tiles traced by ``workers`` spawned processes, in job order."""
+    from app.raytrace.pool import traced_in_pool
 
-    pool = ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"),
-                               initializer=_init_worker, initargs=(scene, backend, shadows))
-    pending: list = []
-    try:
-        queue = iter(jobs)
-        for job in queue:
-            pending.append((job, pool.submit(_trace_tile, *rays(*job), depth, fresnel)))
-            if len(pending) >= 2 * workers:
-                break
-        while pending:
-            job, future = pending.pop(0)
-            radiance, stats = future.result()
-            next_job = next(queue, None)
-            if next_job is not None:
-                pending.append((next_job, pool.submit(_trace_tile, *rays(*next_job), depth,
-                                                      fresnel)))
-            yield job, radiance, stats
-    finally:
-        pool.shutdown(wait=False, cancel_futures=True)
+    for job, (radiance, stats) in traced_in_pool(
+            _init_worker, (scene, backend, shadows), _trace_tile, jobs,
+            lambda job: (*rays(*job), depth, fresnel), workers):
+        yield job, radiance, stats
 
 
 def render_raytraced(scene: Scene, size: tuple[int, int], depth: int | None = None,
