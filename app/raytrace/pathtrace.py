@@ -19,7 +19,11 @@ Estimator (per path vertex, all paths of a bounce as one numpy batch, rays cast 
   after a diffuse bounce; after a mirror or glass bounce (and from the camera) Le counts
   in full. MIS tames the 1/d^2 spikes of light sampling in corners, where plain NEE's
   heavy-tailed estimates make finite-sample means run low;
-- Russian roulette from the fourth vertex, survival min(max(beta), 0.95).
+- Russian roulette from the fourth vertex, survival min(max(beta), 0.95);
+- a ray that leaves the scene sees ``render.background`` as a constant environment
+  radiance (not light-sampled; black in the Cornell presets).
+
+Emitters are two-sided (a closed furnace box converges to Le / (1 - rho) seen from inside).
 """
 
 from __future__ import annotations
