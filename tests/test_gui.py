@@ -76,6 +76,13 @@ def test_kd_slider_changes_the_pixel_as_the_reference_predicts(xdisplay, tmp_pat
     np.testing.assert_allclose(after, r["reference_after"], rtol=1e-4, atol=1e-6)
     assert r["undo_kd"] == 1.0 and r["redo_kd"] == 0.5
     assert r["uploads_before"] == r["uploads_after"]  # a coefficient re-uploads no geometry
+    assert r["screenshots"] == ["shadelab-cornell-001.png"]
+    from PIL import Image
+
+    shot = np.asarray(Image.open(tmp_path / r["screenshots"][0]))
+    assert shot.shape == (r["viewport"][1], r["viewport"][0], 3)
+    band = shot[-20:, :200].astype(int)
+    assert (band > 200).any() and (band < 60).any()  # white legend text on the dark band
 
 
 def test_three_shading_modes_by_key_and_button(xdisplay, tmp_path):
@@ -160,6 +167,10 @@ def scenario_kd_slider(ctx, state, out: dict) -> None:
     ctx.key_press(imgui_key("mod_ctrl") | imgui_key("y"))
     ctx.yield_(2)
     out["redo_kd"] = state.scene.materials["white"].kd
+    ctx.key_press(imgui_key("s"))  # viewport screenshot with the legend burned in
+    ctx.yield_(3)
+    out["screenshots"] = sorted(p.name for p in Path(OUT_DIR).glob("shadelab-*.png"))
+    out["viewport"] = list(state.viewport_size)
 
 
 def scenario_shading_modes(ctx, state, out: dict) -> None:

@@ -292,3 +292,39 @@ def test_legend_is_burned_into_the_bottom_band():
     assert np.array_equal(out[:100], image[:100])
     assert not np.array_equal(out[-30:], image[-30:])
     assert "Phong shading" in legend_lines(state)[0].replace("phong shading", "Phong shading")
+
+
+def test_overlays_ray_tree_and_radiosity_soup_shapes_and_colors():
+    from types import SimpleNamespace
+
+    from app.ui import overlays
+
+    node = SimpleNamespace
+    leaf = node(kind="shadow", origin=np.zeros(3), direction=np.array([0.0, 1.0, 0.0]),
+                end=None, shadow=0.0)
+    root = node(kind="primary", origin=np.ones(3), direction=np.array([1.0, 0.0, 0.0]),
+                end=np.array([4.0, 1.0, 1.0]), shadow=1.0)
+    root.flatten = lambda: iter([(0, root), (1, leaf)])
+    lines = overlays.ray_tree_lines(root, miss_length=10.0)
+    assert lines.shape == (4, 6)
+    np.testing.assert_allclose(lines[1, :3], [4.0, 1.0, 1.0])       # primary ends at its hit
+    np.testing.assert_allclose(lines[3, :3], [0.0, 10.0, 0.0])      # a miss runs on
+    np.testing.assert_allclose(lines[2, 3:], overlays.RAY_COLORS["blocked"])
+    v = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
+    soup = overlays.radiosity_soup([(v, np.array([[0, 1, 2]]), v * 2.0)])
+    assert soup.shape == (3, 6) and soup.dtype == np.float32
+    np.testing.assert_allclose(soup[:, 3:], 2.0 * v)
+
+
+def test_wireframe_and_normal_glyphs_follow_the_mesh():
+    from app.geometry.mesh import scene_meshes
+    from app.ui import overlays
+
+    meshes = scene_meshes(load_preset("cornell"))
+    faces = sum(len(m.faces) for m in meshes)
+    assert overlays.wireframe(meshes).shape == (6 * faces, 6)
+    flat = overlays.normal_glyphs(meshes, 10.0, "flat")
+    assert flat.shape == (2 * faces, 6)
+    lengths = np.linalg.norm(flat[1::2, :3] - flat[0::2, :3], axis=1)
+    np.testing.assert_allclose(lengths, 10.0, rtol=1e-5)
+    assert overlays.normal_glyphs(meshes, 10.0, "phong").shape == (6 * faces, 6)
