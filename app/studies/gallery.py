@@ -3,7 +3,8 @@
 ``GALLERY`` is plain data the viewer lists (name, preset, ``--set`` overrides, method,
 explanation, the test that pins the failure down); :func:`render_case` draws one case with
 its method, and ``shadelab gallery --out DIR`` writes one PNG per case whose renderer exists.
-A method is ``raster:<shading>``, ``raytrace``, ``pathtrace[:<spp>]`` or ``radiosity``.
+A method is ``raster:<shading>``, ``raytrace``, ``pathtrace[:<spp>]`` or
+``radiosity[:uniform]`` (uniform: no adaptive subdivision).
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ class GalleryCase:
     name: str                    # file stem of its PNG, id in the viewer
     preset: str                  # presets/<preset>.toml
     overrides: tuple[str, ...]   # --set KEY=VALUE items applied on load
-    method: str                  # raster:<flat|gouraud|phong> | raytrace | pathtrace | radiosity
+    method: str                  # see the module docstring
     explanation: str             # what fails, and what ShadeLab does about it
     test_name: str               # tests/<file>::<test> that asserts the failure
     requires: str = ""           # a module that must exist (another layer's feature)
@@ -95,7 +96,7 @@ GALLERY: list[GalleryCase] = [
         "1989). Raise radiosity.hemicube_resolution or use raycast/analytic form factors.",
         T + "test09_hemicube_aliasing", requires="app.radiosity.solution"),
     GalleryCase(
-        "radiosity-light-leak", "radiosity-leak", (), "radiosity",
+        "radiosity-light-leak", "radiosity-leak", ("radiosity.patches=40",), "radiosity:uniform",
         "A patch that runs under a wall is lit as a whole, so light appears on the dark side "
         "(a leak); radiosity is constant per patch. Mesh along the contact lines or use more "
         "patches.",
@@ -183,13 +184,13 @@ def render_case(case: GalleryCase, size: tuple[int, int]) -> tuple[np.ndarray, f
         *_, last = iter_pathtrace(scene, size, int(variant or 16))
         image = last.image
     elif kind == "radiosity":
-        image = _render_radiosity(scene, size)
+        image = _render_radiosity(scene, size, adaptive=variant != "uniform")
     else:
         raise GallerySkipped(f"method {case.method} is not known here")
     return np.asarray(image, dtype=np.float32), scene.render.exposure
 
 
-def _render_radiosity(scene, size: tuple[int, int]) -> np.ndarray:
+def _render_radiosity(scene, size: tuple[int, int], adaptive: bool = True) -> np.ndarray:
     from app.radiosity.solution import solve_scene
 
-    return solve_scene(scene).image(size)
+    return solve_scene(scene, adaptive=adaptive).image(size)

@@ -9,13 +9,12 @@ processes on the machine only ever add time.
 from __future__ import annotations
 
 import importlib.util
-import time
 
 import numpy as np
 
 from app.scene.model import Scene
 from app.studies import metrics
-from app.studies.result import StudyResult, StudySkipped
+from app.studies.result import StudyResult, StudySkipped, study_clock
 
 COLUMNS = ["depth", "spp", "time_ms", "mae", "rmse", "relmse"]
 PRESET = "whitted"   # a mirror and a glass sphere over a checkerboard: depth matters
@@ -30,10 +29,10 @@ def trace(scene: Scene, size: tuple[int, int], depth: int, spp: int, ctx, seed: 
     """The finished Whitted image (H, W, 3) float64 and its wall time in milliseconds."""
     from app.raytrace.whitted import iter_raytrace
 
-    start = time.perf_counter()
+    start = study_clock()
     steps = list(iter_raytrace(scene, size, depth, spp, seed=seed, ctx=ctx))
     last = steps[-1]
-    return np.asarray(last.image, dtype=np.float64), (time.perf_counter() - start) * 1000.0
+    return np.asarray(last.image, dtype=np.float64), (study_clock() - start) * 1000.0
 
 
 def measure(scene: Scene, size: tuple[int, int], depths, spps, reference: tuple[int, int],
@@ -75,7 +74,8 @@ def run_raytrace(quick: bool = False) -> StudyResult:
         name="raytrace", title=f"Whitted ({PRESET}, {size[0]}x{size[1]}): error vs time",
         columns=list(COLUMNS), rows=rows, x="time_ms", y="relmse", group="spp", label="depth",
         notes=[f"reference: depth {reference[0]}, {reference[1]} spp (other jitter seed)",
-               "series: samples per pixel; labels: recursion depth"],
+               "series: samples per pixel; labels: recursion depth",
+               "time: process CPU time, best of the rounds (app.studies.result.study_clock)"],
         extra={"depth": by_depth})
 
 

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import csv
+import os
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -76,3 +78,15 @@ def _cell(value):
     if isinstance(value, float):
         return f"{value:.6g}"
     return value
+
+
+def study_clock() -> float:
+    """Seconds of CPU time of this process, all threads (llvmpipe, Embree, numpy, numba).
+
+    The studies time work with it rather than the wall clock: on a shared machine other jobs
+    add wall time at random, never CPU time of ours. ``SHADELAB_STUDY_CLOCK=wall`` switches to
+    the wall clock (for a real GPU, whose work the process's CPU time does not see).
+    """
+    if os.environ.get("SHADELAB_STUDY_CLOCK", "cpu") == "wall":
+        return time.perf_counter()
+    return time.process_time()
