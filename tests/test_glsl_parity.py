@@ -13,7 +13,7 @@ import moderngl
 import numpy as np
 import pytest
 
-from app.gl.programs import register_includes, set_uniform
+from app.gl.programs import register_includes, set_uniform, with_defines
 from app.render.renderer import Renderer, write_light_uniforms
 from app.scene.model import Light, Material
 from app.shading.reference import normalize, shade
@@ -37,11 +37,15 @@ def _random_material(rng: np.random.Generator) -> Material:
                     Os=tuple(rng.uniform(0, 1, 3)), emission=tuple(rng.uniform(0, 0.2, 3)))
 
 
-@pytest.fixture(scope="module")
-def harness(gl_ctx):
+@pytest.fixture(scope="module", params=[None, 3], ids=["uniform-count", "NUM_LIGHTS=3"])
+def harness(gl_ctx, request):
+    """The include as the parity harness compiles it: with a uniform light count, or
+    specialized to 3 lights as the renderer compiles it (``#define NUM_LIGHTS``)."""
     register_includes(gl_ctx)
-    program = gl_ctx.program(vertex_shader=(SHADERS / "parity.vert").read_text(),
-                             fragment_shader=(SHADERS / "parity.frag").read_text())
+    defines = {"NUM_LIGHTS": request.param} if request.param else None
+    program = gl_ctx.program(
+        vertex_shader=(SHADERS / "parity.vert").read_text(),
+        fragment_shader=with_defines((SHADERS / "parity.frag").read_text(), defines))
     target = gl_ctx.simple_framebuffer((N_POINTS, 1), components=4, dtype="f4")
     return gl_ctx, program, target
 
@@ -86,8 +90,13 @@ def test_glsl_matches_numpy(harness, np_rng, specular, kind, attenuation):
         np.testing.assert_allclose(gpu, ref, rtol=1e-4, atol=1e-5)
 
 
-def test_eight_lights_and_more(harness, np_rng):
+def test_eight_lights_and_more(gl_ctx, np_rng):
     """All MAX_LIGHTS slots are summed (the renderer promises at least 8 at once)."""
+    register_includes(gl_ctx)
+    program = gl_ctx.program(vertex_shader=(SHADERS / "parity.vert").read_text(),
+                             fragment_shader=with_defines((SHADERS / "parity.frag").read_text(),
+                                                          {"NUM_LIGHTS": 16}))
+    harness = (gl_ctx, program, gl_ctx.simple_framebuffer((N_POINTS, 1), components=4, dtype="f4"))
     points = np_rng.uniform(-1, 1, (N_POINTS, 3))
     normals = normalize(np_rng.normal(size=(N_POINTS, 3)))
     od = np.ones((N_POINTS, 3))

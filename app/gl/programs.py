@@ -15,15 +15,27 @@ def register_includes(ctx: moderngl.Context) -> None:
         ctx.includes[path.stem] = path.read_text(encoding="utf-8")
 
 
-def load_program(ctx: moderngl.Context, name: str) -> moderngl.Program:
-    """Compile ``shaders/<name>.vert`` and ``<name>.frag`` (and ``<name>.geom`` if present)."""
+def with_defines(source: str, defines: dict[str, object] | None) -> str:
+    """Insert ``#define NAME VALUE`` lines right after the ``#version`` line."""
+    if not defines:
+        return source
+    first, _, rest = source.partition("\n")
+    lines = "".join(f"#define {key} {value}\n" for key, value in defines.items())
+    return f"{first}\n{lines}{rest}"
+
+
+def load_program(ctx: moderngl.Context, name: str,
+                 defines: dict[str, object] | None = None) -> moderngl.Program:
+    """Compile ``shaders/<name>.vert`` and ``<name>.frag`` (and ``<name>.geom`` if present),
+    with optional ``#define``s (e.g. ``NUM_LIGHTS``) inserted in every stage."""
     register_includes(ctx)
     folder = shaders_dir()
-    sources = {"vertex_shader": (folder / f"{name}.vert").read_text(encoding="utf-8"),
-               "fragment_shader": (folder / f"{name}.frag").read_text(encoding="utf-8")}
-    geometry = folder / f"{name}.geom"
-    if geometry.is_file():
-        sources["geometry_shader"] = geometry.read_text(encoding="utf-8")
+    stages = {"vertex_shader": "vert", "fragment_shader": "frag", "geometry_shader": "geom"}
+    sources = {}
+    for stage, suffix in stages.items():
+        path = folder / f"{name}.{suffix}"
+        if path.is_file():
+            sources[stage] = with_defines(path.read_text(encoding="utf-8"), defines)
     return ctx.program(**sources)
 
 

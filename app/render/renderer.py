@@ -80,11 +80,41 @@ class Renderer:
 
     def __init__(self, ctx: moderngl.Context):
         self.ctx = ctx
-        self.programs = {name: load_program(ctx, name) for name in SHADING_PROGRAMS}
-        self.programs.update({tex: load_program(ctx, tex) for tex in TEXTURED_PROGRAMS.values()})
+        self._variants: dict[int, dict[str, moderngl.Program]] = {}
+        self.light_count = 1
+        self.programs = self.programs_for_lights(1)
         self.textures = TextureCache(ctx)
         self._gpu: dict[int, GpuMesh] = {}
         self._shadows = None  # app.render.shadows.ShadowVolumes, made on first use
+
+    def programs_for_lights(self, count: int) -> dict[str, moderngl.Program]:
+        """Every shading program compiled for ``count`` lights (cached).
+
+        Passes that draw fewer lights (the shadow passes draw one at a time) fill the other
+        slots with Ip = 0, which adds exactly nothing.
+        """
+        if count not in self._variants:
+            names = [*SHADING_PROGRAMS, *TEXTURED_PROGRAMS.values()]
+            self._variants[count] = {name: load_program(self.ctx, name, {"NUM_LIGHTS": count})
+                                     for name in names}
+        return self._variants[count]
+
+    def use_light_count(self, count: int) -> None:
+        """Make ``self.programs`` the variant for ``count`` lights (once per frame)."""
+        self.light_count = count
+        self.programs = self.programs_for_lights(count)
+
+    def vao(self, gpu: GpuMesh, program_name: str) -> moderngl.VertexArray:
+        """The object's VAO for a program of the current light-count variant (made lazily)."""
+        key = f"{program_name}/{self.light_count}"
+        vao = gpu.vaos.get(key)
+        if vao is None:
+            program = self.programs[program_name]
+            layout = [a if a in program else None for a in VERTEX_ATTRIBUTES]
+            vao = self.ctx.vertex_array(program, [(gpu.vbo, _padded_format(layout),
+                                                   *[a for a in layout if a])])
+            gpu.vaos[key] = vao
+        return vao
 
     # ------------------------------------------------------------ geometry
     def sync(self, scene: Scene) -> list[GpuMesh]:
@@ -106,12 +136,7 @@ class Renderer:
 
     def _upload(self, key: tuple, mesh: MeshData) -> GpuMesh:
         vbo = self.ctx.buffer(triangle_soup(mesh).tobytes())
-        vaos = {}
-        for name, program in self.programs.items():
-            layout = [a if a in program else None for a in VERTEX_ATTRIBUTES]
-            fmt = _padded_format(layout)
-            vaos[name] = self.ctx.vertex_array(program, [(vbo, fmt, *[a for a in layout if a])])
-        return GpuMesh(key, mesh, vbo, vaos)
+        return GpuMesh(key, mesh, vbo, {})  # VAOs are made per program variant on first draw
 
     # ------------------------------------------------------------ uniforms
     def variants(self, shading: str) -> list[moderngl.Program]:
@@ -157,6 +182,7 @@ class Renderer:
         settings = scene.render
         gpu_meshes = self.sync(scene)
         lights = scene.active_lights()[:MAX_LIGHTS]
+        self.use_light_count(len(lights))
         painter = settings.visibility == "painter"
         shadowed = settings.shadows == "volumes" and bool(lights) and not painter
         # Shadow volumes reach infinity (w = 0): the whole frame then uses an infinite far plane.
@@ -258,14 +284,16 @@ class Renderer:
     def draw_objects(self, scene: Scene, gpu_meshes: list[GpuMesh], shading: str) -> None:
         for gpu in gpu_meshes:
             program_name = self.use_material(scene, gpu.mesh.material, shading)
-            gpu.vaos[program_name].render(moderngl.TRIANGLES)
+            self.vao(gpu, program_name).render(moderngl.TRIANGLES)
 
     def release(self) -> None:
         for gpu in self._gpu.values():
             gpu.release()
         self._gpu.clear()
-        for program in self.programs.values():
-            program.release()
+        for variant in self._variants.values():
+            for program in variant.values():
+                program.release()
+        self._variants.clear()
         if self._shadows is not None:
             self._shadows.release()
             self._shadows = None

@@ -7,6 +7,14 @@
 //   f_att = 1 | 1/d^2 | min(1/(c1 + c2 d + c3 d^2), 1);   R = 2N(N.L) - L;   H = (L+V)/|L+V|
 
 #define MAX_LIGHTS 16
+// The renderer compiles one variant per light count (NUM_LIGHTS): a constant loop unrolls
+// and its array indices become constants, which llvmpipe runs about 2x faster than a loop
+// bounded by a uniform. Without the define the uniform count is used (parity harness).
+#ifdef NUM_LIGHTS
+#define LIGHT_COUNT NUM_LIGHTS
+#else
+#define LIGHT_COUNT u_num_lights
+#endif
 #define LIGHT_POINT 0
 #define LIGHT_DIRECTIONAL 1
 #define LIGHT_SPOT 2
@@ -101,7 +109,7 @@ vec3 shade(vec3 position, vec3 n, vec3 eye, vec3 od) {
     float len = length(to_eye);
     to_eye = len > SHADING_EPS ? to_eye / len : vec3(0.0);
     vec3 color = u_ambient_on * (u_emission + u_Ia * u_ka * od);
-    for (int i = 0; i < u_num_lights; ++i)
+    for (int i = 0; i < LIGHT_COUNT; ++i)
         color += shade_light(i, position, n, to_eye, od);
     return color;
 }
