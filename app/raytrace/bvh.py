@@ -1,7 +1,8 @@
 """A plain bounding-volume hierarchy in numba: the fallback where embreex is missing.
 
-Median split on the longest centroid axis, up to ``LEAF_SIZE`` triangles per leaf; rays are
-traversed in parallel (``prange``) with a per-ray stack, Moller-Trumbore tests in float64.
+Median split on the longest centroid axis (built in numpy), up to ``LEAF_SIZE`` triangles
+per leaf; rays are traversed in parallel (``prange``) with a per-ray stack, Moller-Trumbore
+tests in float64.
 The barycentric convention matches Embree's: ``p = (1 - u - v) p0 + u p1 + v p2``.
 """
 
@@ -32,8 +33,8 @@ class Bvh:
     e2: np.ndarray      # (F, 3) float64 p2 - p0
 
 
-@nb.njit(cache=True)
-def _build(tri_lo, tri_hi, centroids, leaf_size):
+def _build(tri_lo: np.ndarray, tri_hi: np.ndarray, centroids: np.ndarray, leaf_size: int):
+    """Median-split build in numpy (a few thousand nodes: fast enough, and nothing to JIT)."""
     n = len(centroids)
     cap = max(2 * n, 1)
     lo = np.zeros((cap, 3))
@@ -42,44 +43,28 @@ def _build(tri_lo, tri_hi, centroids, leaf_size):
     b = np.zeros(cap, np.int64)
     count = np.zeros(cap, np.int64)
     prims = np.arange(n)
-    stack = np.zeros((128, 3), np.int64)  # node, start, end
-    stack[0, 0], stack[0, 1], stack[0, 2] = 0, 0, n
-    top = 1
+    stack = [(0, 0, n)]  # node, start, end
     used = 1
-    while top > 0:
-        top -= 1
-        node, start, end = stack[top, 0], stack[top, 1], stack[top, 2]
-        # Bound the node's triangles and their centroids
-        blo = np.full(3, np.inf)
-        bhi = np.full(3, -np.inf)
-        clo = np.full(3, np.inf)
-        chi = np.full(3, -np.inf)
-        for i in range(start, end):
-            p = prims[i]
-            for k in range(3):
-                blo[k] = min(blo[k], tri_lo[p, k])
-                bhi[k] = max(bhi[k], tri_hi[p, k])
-                clo[k] = min(clo[k], centroids[p, k])
-                chi[k] = max(chi[k], centroids[p, k])
-        lo[node] = blo
-        hi[node] = bhi
+    while stack:
+        node, start, end = stack.pop()
+        members = prims[start:end]
+        # Bound the node's triangles
+        lo[node] = tri_lo[members].min(axis=0)
+        hi[node] = tri_hi[members].max(axis=0)
         if end - start <= leaf_size:
             a[node], count[node] = start, end - start
             continue
         # Split at the median along the longest centroid axis
-        axis = np.argmax(chi - clo)
-        keys = np.empty(end - start)
-        for i in range(start, end):
-            keys[i - start] = centroids[prims[i], axis]
-        order = np.argsort(keys)
-        prims[start:end] = prims[start:end][order]
-        mid = (start + end) // 2
+        c = centroids[members]
+        axis = int(np.argmax(c.max(axis=0) - c.min(axis=0)))
+        mid = (end - start) // 2
+        order = np.argpartition(c[:, axis], mid)
+        prims[start:end] = members[order]
         left, right = used, used + 1
         used += 2
         a[node], b[node], count[node] = left, right, 0
-        stack[top, 0], stack[top, 1], stack[top, 2] = left, start, mid
-        stack[top + 1, 0], stack[top + 1, 1], stack[top + 1, 2] = right, mid, end
-        top += 2
+        stack.append((left, start, start + mid))
+        stack.append((right, start + mid, end))
     return lo[:used], hi[:used], a[:used], b[:used], count[:used], prims
 
 
