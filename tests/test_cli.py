@@ -61,3 +61,14 @@ def test_python_dash_m_app_is_the_same_command():
                          capture_output=True, text=True)
     assert bad.returncode == 2 and bad.stderr.startswith("shadelab: error: unknown preset")
     assert "Traceback" not in bad.stderr
+
+
+def test_no_egl_gives_one_line_with_what_to_install(tmp_path):
+    env = {**__import__("os").environ, "SHADELAB_LIBEGL": str(tmp_path / "libEGL-missing.so")}
+    out = subprocess.run([sys.executable, "-m", "app", "render", "cornell", "-o",
+                          str(tmp_path / "x.png"), "--size", "8x8"],
+                         capture_output=True, text=True, env=env)
+    assert out.returncode == 2
+    assert out.stderr.count("\n") == 1 and "Traceback" not in out.stderr
+    assert "EGL" in out.stderr and "apt-get install libegl1 libgl1-mesa-dri" in out.stderr
+    assert not (tmp_path / "x.png").exists()

@@ -161,3 +161,11 @@ def test_error_type_is_one_line():
     with pytest.raises(ShadeLabError) as info:
         load_preset("definitely-missing")
     assert "\n" not in str(info.value)
+
+
+def test_schema_json_is_generated_from_the_model():
+    from app.resources import presets_dir
+    from app.scene.schema import schema_text
+
+    committed = (presets_dir() / "schema.json").read_text()
+    assert committed == schema_text(), "regenerate: python -m app.scene.schema > presets/schema.json"
