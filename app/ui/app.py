@@ -194,7 +194,8 @@ class Viewer:
     started: float = field(default_factory=time.perf_counter)
     _line_cache: dict = field(default_factory=dict)
     _frame_key: tuple = ()
-    force_redraw: bool = False         # the bench's second half: re-render every frame
+    force_redraw: bool = False         # the bench's later phases: re-render every frame
+    force_interactive: bool = False    # the bench's last phase: as if a slider were dragged
     redrawn: bool = False              # this frame re-rendered the scene
     redraw_flags: list = field(default_factory=list)
     cpu_times: list = field(default_factory=list)
@@ -297,8 +298,10 @@ class Viewer:
     def draw_main(self, size: tuple[int, int]) -> None:
         state, vp = self.state, self.viewport
         scene = state.scene
+        display_size, size = size, self.render_size(size)
         if "main" in vp.panes and self.unchanged(size):
-            self._handle_click(self._image_with_input(vp.panes["main"].display, size), size)
+            self._handle_click(self._image_with_input(vp.panes["main"].display, display_size),
+                               display_size)
             return
         # --- PASS 1-2: the scene into the float target (the Renderer's passes), or the solved
         # radiosity meshes, Gouraud-interpolated (view-independent: walk around them)
@@ -310,7 +313,7 @@ class Viewer:
             pane = vp.draw_scene("main", scene, size, scene.render.shading, scene.render.specular)
         # --- PASS 3: the probe reads the GPU value before any overlay is drawn
         if state.probe_requested:
-            self.update_probe(size)
+            self.update_probe(size, display_size)
         # --- PASS 4: overlays (wireframe, normal glyphs, probe arrows)
         exposure = scene.render.exposure
         meshes = scene_meshes(scene)
@@ -330,7 +333,18 @@ class Viewer:
         if state.screenshot_requested:
             self.write_viewport_screenshot(state.screenshot_requested)
             state.screenshot_requested = ""
-        self._handle_click(self._image_with_input(texture, size), size)
+        self._handle_click(self._image_with_input(texture, display_size), display_size)
+
+    def interacting(self) -> bool:
+        """A slider or the camera is being dragged right now."""
+        return self.force_interactive or (self.state.edit_pending and imgui.is_any_item_active())
+
+    def render_size(self, size: tuple[int, int]) -> tuple[int, int]:
+        """The scene's resolution: the viewport's times the render scale (lower mid-drag)."""
+        scale = self.state.render_scale
+        if self.interacting():
+            scale = min(scale, self.state.interactive_scale)
+        return max(int(size[0] * scale), 8), max(int(size[1] * scale), 8)
 
     def _handle_click(self, clicked, size: tuple[int, int]) -> None:
         if clicked is not None:
@@ -353,13 +367,20 @@ class Viewer:
             self._line_cache[key] = lines
         return self._line_cache[key]
 
-    def update_probe(self, size: tuple[int, int]) -> None:
-        """Recompute the probed pixel's terms (CPU reference) and read what the GPU drew."""
+    def update_probe(self, size: tuple[int, int], display_size: tuple[int, int]) -> None:
+        """Recompute the probed pixel's terms (CPU reference) and read what the GPU drew.
+
+        ``state.probe_pixel`` is in viewport pixels; the scene may be rendered at another
+        resolution (render scale), so the pixel is mapped to the rendered image first.
+        """
         state = self.state
-        pixel = state.probe_pixel
-        if pixel is None or not (0 <= pixel[0] < size[0] and 0 <= pixel[1] < size[1]):
+        shown = state.probe_pixel
+        if shown is None or not (0 <= shown[0] < display_size[0]
+                                 and 0 <= shown[1] < display_size[1]):
             state.probe = None
             return  # (kept requested: the layout may still be settling)
+        pixel = (min(int(shown[0] * size[0] / display_size[0]), size[0] - 1),
+                 min(int(shown[1] * size[1] / display_size[1]), size[1] - 1))
         state.probe_requested = False
         result = probe(state.scene, size, pixel)
         if result is not None and not state.show_radiosity:
@@ -477,10 +498,13 @@ class Viewer:
             self.first_frame = now
         self.frame_times.append(now)
         self.cpu_times.append(time.process_time())
-        self.redraw_flags.append(self.redrawn)
+        self.redraw_flags.append(0 if not self.redrawn else (2 if self.force_interactive else 1))
         state.frame += 1
         if self.options.bench_json and self.options.frames:
-            self.force_redraw = state.frame >= self.options.frames // 2
+            # Phases: idle (GUI only), full-resolution redraw, interactive (drag) redraw.
+            third = self.options.frames // 3
+            self.force_redraw = state.frame >= third
+            self.force_interactive = state.frame >= 2 * third
         waiting = self.options.job and (state.job.running or not state.job.started
                                         or state.job_version != state.job.version)
         if self.options.job and not waiting and not self._job_followed_up:
@@ -529,11 +553,12 @@ class Viewer:
     def write_bench(self) -> None:
         """Frame times of idle frames (GUI only) and of frames that re-render the scene."""
         times = np.diff(np.asarray(self.frame_times)) * 1000.0
-        flags = np.asarray(self.redraw_flags[1:], dtype=bool)
+        flags = np.asarray(self.redraw_flags[1:])
         report = {"first_frame_s": self.first_frame_since_start(),
                   "frames": len(self.frame_times), "window": list(self.options.window_size)}
         cpu = np.diff(np.asarray(self.cpu_times)) * 1000.0
-        for name, select in (("idle", ~flags), ("redraw", flags)):
+        for name, select in (("idle", flags == 0), ("redraw", flags == 1),
+                             ("interactive", flags == 2)):
             picked, picked_cpu = times[select][5:], cpu[select][5:]  # skip warm-up frames
             if len(picked):
                 report[f"{name}_frame_ms_median"] = float(np.median(picked))
@@ -607,6 +632,9 @@ def _scene_panel(state: AppState) -> bool:
     _, state.legend_in_screenshot = imgui.checkbox("with legend", state.legend_in_screenshot)
     if imgui.button("Reset view (R)"):
         state.reset_view()
+    _, state.render_scale = panels._slider("render scale", state.render_scale, 0.25, 1.0)
+    _, state.interactive_scale = panels._slider("while dragging", state.interactive_scale,
+                                                0.25, 1.0)
     return edited
 
 

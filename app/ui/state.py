@@ -121,6 +121,8 @@ class AppState:
     diff_pair: tuple[int, int] = (0, 2)   # indices into COMPARE_VIEWS
     diff_scale: float = 0.2           # heat map: this difference (x exposure) is full red
     presenter: bool = False
+    render_scale: float = 1.0         # scene resolution / viewport resolution
+    interactive_scale: float = 0.5    # the same while a slider or the camera is dragged
     show_help: bool = False
     legend_in_screenshot: bool = True
     # Probe
@@ -177,6 +179,7 @@ class AppState:
     def commit_edit(self) -> None:
         """Close an edit: snapshot for undo, recompute the unsaved flag."""
         self.edit_pending = False
+        self.probe_requested = self.probe_pixel is not None  # again, at full resolution
         self.history.push(self.scene)
         self.dirty = scene_to_dict(self.scene) != self.saved
 

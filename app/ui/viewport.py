@@ -76,7 +76,7 @@ class Viewport:
         target = RenderTarget(self.ctx, size)
         target.color.filter = (moderngl.NEAREST, moderngl.NEAREST)
         display = self.ctx.texture(size, 4, dtype="f1")
-        display.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        display.filter = (moderngl.LINEAR, moderngl.LINEAR)  # upscaled at render scale < 1
         pane = Pane(target, display, self.ctx.framebuffer([display]))
         self.panes[key] = pane
         return pane
