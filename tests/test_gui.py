@@ -76,6 +76,11 @@ def test_kd_slider_changes_the_pixel_as_the_reference_predicts(xdisplay, tmp_pat
     np.testing.assert_allclose(after, r["reference_after"], rtol=1e-4, atol=1e-6)
     assert r["undo_kd"] == 1.0 and r["redo_kd"] == 0.5
     assert r["uploads_before"] == r["uploads_after"]  # a coefficient re-uploads no geometry
+    assert r["two_lights"] == [2, 2] and r["light_off"] == [2, 1]
+    np.testing.assert_allclose(r["two_lights_gpu"], r["two_lights_reference"], rtol=1e-4,
+                               atol=1e-6)
+    np.testing.assert_allclose(r["light_off_gpu"], r["gpu_after"], rtol=1e-5)  # back to one
+    assert np.max(r["two_lights_gpu"]) > np.max(r["gpu_after"])  # the new light adds light
     assert r["screenshots"] == ["shadelab-cornell-001.png"]
     from PIL import Image
 
@@ -167,6 +172,19 @@ def scenario_kd_slider(ctx, state, out: dict) -> None:
     ctx.key_press(imgui_key("mod_ctrl") | imgui_key("y"))
     ctx.yield_(2)
     out["redo_kd"] = state.scene.materials["white"].kd
+    ctx.window_focus("//Lights")  # add a light, then switch it off again
+    ctx.set_ref("//Lights")
+    ctx.item_click("Add light")
+    ctx.yield_(3)
+    _probe_at(ctx, state, _centre(state))
+    out["two_lights"] = [len(state.scene.lights), len(state.probe.terms.lights)]
+    out["two_lights_gpu"] = state.probe.gpu.tolist()
+    out["two_lights_reference"] = state.probe.reference.tolist()
+    ctx.item_uncheck("light1/##on")
+    ctx.yield_(3)
+    _probe_at(ctx, state, _centre(state))
+    out["light_off"] = [len(state.scene.lights), len(state.scene.active_lights())]
+    out["light_off_gpu"] = state.probe.gpu.tolist()
     ctx.key_press(imgui_key("s"))  # viewport screenshot with the legend burned in
     ctx.yield_(3)
     out["screenshots"] = sorted(p.name for p in Path(OUT_DIR).glob("shadelab-*.png"))

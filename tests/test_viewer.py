@@ -328,3 +328,28 @@ def test_wireframe_and_normal_glyphs_follow_the_mesh():
     lengths = np.linalg.norm(flat[1::2, :3] - flat[0::2, :3], axis=1)
     np.testing.assert_allclose(lengths, 10.0, rtol=1e-5)
     assert overlays.normal_glyphs(meshes, 10.0, "phong").shape == (6 * faces, 6)
+
+
+def test_view_restores_the_autosaved_session_unless_fresh_or_another_preset(tmp_path,
+                                                                          monkeypatch, capsys):
+    import argparse
+
+    from app.ui.commands import load_scene
+
+    monkeypatch.setenv("XDG_STATE_HOME", str(tmp_path / "xdg"))
+    scene = load_preset("cornell")
+    scene.materials["red"].kd = 0.125
+    save_session(scene, "cornell")
+
+    def args(preset=None, fresh=False, overrides=()):
+        return argparse.Namespace(preset=preset, fresh=fresh, set=list(overrides))
+
+    restored, source = load_scene(args())
+    assert source == "cornell" and restored.materials["red"].kd == 0.125
+    assert "restored the autosaved session" in capsys.readouterr().out
+    assert load_scene(args("cornell"))[0].materials["red"].kd == 0.125
+    assert load_scene(args("cornell", fresh=True))[0].materials["red"].kd == 1.0
+    other, name = load_scene(args("sphere-shading"))
+    assert name == "sphere-shading" and "red" not in other.materials
+    overridden = load_scene(args("cornell", overrides=["materials.red.kd=0.5"]))[0]
+    assert overridden.materials["red"].kd == 0.5
