@@ -98,7 +98,7 @@ def run_radiosity(quick: bool = False) -> StudyResult:
     convergence_table = StudyResult(
         name="radiosity-convergence", title="Radiosity: convergence per solver",
         columns=list(CONVERGENCE_COLUMNS), rows=conv, x="iteration", y="residual",
-        group="solver", log_x=False)
+        group="solver")
     return StudyResult(
         name="radiosity", title=f"Radiosity ({PRESET}, {size[0]}x{size[1]}): error vs time",
         columns=list(COLUMNS), rows=rows, x="time_ms", y="relmse", group="series",
