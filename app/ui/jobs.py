@@ -163,18 +163,24 @@ def _raytrace_factory():
     return None, reason
 
 
-def _pathtrace_factory(spp: int = 4, seed: int = 1):
+def _pathtrace_factory(seed: int = 1):
+    """The path tracer at the scene's samples per pixel (the panel sets them)."""
     fn, reason = _lookup("app.raytrace.pathtrace", ("iter_pathtrace",))
     if fn is None:
         return None, reason
-    return (lambda scene, size: fn(scene, size, spp, seed)), ""
+    return (lambda scene, size: fn(scene, size, max(scene.raytrace.spp, 1), seed)), ""
 
 
 def _radiosity_factory():
+    """Radiosity; GPU hemicube form factors would need a GL context in the worker thread
+    (the viewer's context belongs to the UI thread), so the viewer asks for ray-cast ones."""
     for module in ("app.radiosity", "app.radiosity.solver"):
         fn, reason = _lookup(module, ("iter_radiosity",))
         if fn is not None:
-            return fn, ""
+            def make(scene, size, fn=fn):
+                method = "raycast" if scene.radiosity.form_factors == "hemicube" else None
+                return fn(scene, size, form_factors=method)
+            return make, ""
     return None, reason
 
 

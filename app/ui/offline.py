@@ -12,6 +12,7 @@ from app.ui.jobs import available_jobs, difference
 from app.ui.state import AppState
 
 SIZES = (32, 64, 96, 128, 192, 256, 384, 512)
+SAMPLES = (1, 4, 16, 64, 256)
 
 
 def heat_map(a: np.ndarray, b: np.ndarray, scale: float) -> np.ndarray:
@@ -36,6 +37,8 @@ def start_job(state: AppState, index: int) -> None:
         state.error = f"{kind.label}: not available ({kind.reason})"
         return
     scene = clone_scene(state.scene)
+    if kind.label.startswith("Path"):
+        scene.raytrace.spp = state.job_spp
     size = _job_size(state)
     if state.gl is not None:
         state.gl.draw_scene("job_raster", scene, size, kind.raster_shading, scene.render.specular)
@@ -170,6 +173,10 @@ def draw_offline_panel(state: AppState) -> bool:
     index = SIZES.index(state.job_size) if state.job_size in SIZES else 3
     _, index = imgui.combo("Height (px)", index, [str(s) for s in SIZES])
     state.job_size = SIZES[index]
+    if kind.label.startswith("Path"):
+        index = SAMPLES.index(state.job_spp) if state.job_spp in SAMPLES else 0
+        _, index = imgui.combo("Samples / pixel", index, [str(n) for n in SAMPLES])
+        state.job_spp = SAMPLES[index]
     imgui.begin_disabled(job.running or kind.make is None)
     if imgui.button("Start"):
         start_job(state, state.job_kind)

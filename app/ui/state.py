@@ -146,6 +146,7 @@ class AppState:
     job: Any = None                   # app.ui.jobs.JobRunner
     job_kind: int = 0
     job_size: int = 128
+    job_spp: int = 16                 # samples per pixel (path tracer; Whitted anti-aliasing)
     job_compare: Any = None           # dict of error figures vs the raster view
     job_raster: Any = None            # (H, W, 3) raster image the job is compared with
     job_kinds: Any = None             # app.ui.jobs.available_jobs(), found on first use
