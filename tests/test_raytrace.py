@@ -232,6 +232,20 @@ def test_ray_tree_contributions_sum_to_the_pixel():
     assert "refracted" in kinds and "shadow" in kinds
 
 
+def test_ray_tree_shadow_ray_names_its_blocker():
+    """A floor pixel in the mirror sphere's shadow: S = 0, the blocker is the sphere."""
+    scene = load_preset("cornell-spheres")
+    mirror = [o.name for o in scene.objects].index("mirror_sphere")
+    floor = [o.name for o in scene.objects].index("floor")
+    tree = trace_pixel_tree(scene, (32, 32), 12, 27, depth=2)
+    assert tree.kind == "primary" and tree.object == floor
+    shadow = [n for n in tree.children if n.kind == "shadow"]
+    assert len(shadow) == 1 and shadow[0].shadow == 0.0 and shadow[0].object == mirror
+    centre = np.array([370.0, 100.0, 350.0])
+    assert abs(np.linalg.norm(shadow[0].end - centre) - 100.0) < 1.0  # on the sphere
+    np.testing.assert_allclose(tree.local, 0.0, atol=1e-12)  # kd Od, but no light: black
+
+
 # ------------------------------------------------------------------ shadows
 
 
