@@ -97,7 +97,7 @@ def run_radiosity(quick: bool = False) -> StudyResult:
             conv.extend(convergence(sol, solver))
     convergence_table = StudyResult(
         name="radiosity-convergence", title="Radiosity: convergence per solver",
-        columns=list(CONVERGENCE_COLUMNS), rows=conv, x="iteration", y="residual",
+        columns=list(CONVERGENCE_COLUMNS), rows=conv, x="time_ms", y="residual",
         group="solver")
     return StudyResult(
         name="radiosity", title=f"Radiosity ({PRESET}, {size[0]}x{size[1]}): error vs time",
