@@ -107,7 +107,9 @@ def run_radiosity(quick: bool = False) -> StudyResult:
                f"factors, direct solve",
                "series raycast/hemicube/analytic: patch count sweep (hemicube at 64 px)",
                f"hemicube-resolution: {fixed} patches; solver: {fixed} patches, ray-cast",
-               "convergence: relative residual (progressive: unshot energy share)",
+               "convergence: relative residual (progressive: unshot energy share) against "
+               "solver time; Jacobi and Gauss-Seidel start from a finished F, progressive "
+               "refinement computes its rows of F as it shoots",
                "'analytic' form factors ignore occlusion (the blocks): a biased floor",
                "time: process CPU time (app.studies.result.study_clock)"],
         extra={"convergence": convergence_table})
