@@ -349,12 +349,12 @@ class TileJob:
 
     def __init__(self, scene: Scene, size: tuple[int, int], spp: int, seed: int,
                  backend: str, local: str):
-        from app.scene.camera import _basis  # the camera's own frame, so the images align
+        from app.scene.camera import camera_basis  # the camera's own frame, so the images align
 
         self.tracer = PathTracer(scene, backend, local=local)
         self.size, self.spp, self.seed = size, spp, seed
         cam = scene.camera
-        self.frame = _basis(cam)
+        self.frame = camera_basis(cam)
         self.eye = np.asarray(cam.eye, dtype=np.float64)
         self.tan_half = math.tan(math.radians(cam.fov_y) / 2.0)
 

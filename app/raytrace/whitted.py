@@ -190,12 +190,12 @@ def iter_raytrace(scene: Scene, size: tuple[int, int], depth: int | None = None,
 def _tile_rays(scene: Scene, size: tuple[int, int], spp: int, seed: int):
     """rays(sample, r0, r1) -> (origins, dirs) of a tile, flattened, as
     :func:`app.scene.camera.primary_rays` gives them (a numba mirror, per tile)."""
-    from app.scene.camera import _basis  # the camera's own frame, so the images align
+    from app.scene.camera import camera_basis  # the camera's own frame, so the images align
 
     width, height = size
     rng = np.random.default_rng(seed)
     cam = scene.camera
-    forward, right, up = _basis(cam)
+    forward, right, up = camera_basis(cam)
     eye = np.asarray(cam.eye, dtype=np.float64)
     tan_half = math.tan(math.radians(cam.fov_y) / 2.0)
     cache: dict = {}

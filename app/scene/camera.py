@@ -14,7 +14,7 @@ from pyrr import Matrix44
 from app.scene.model import Camera
 
 
-def _basis(camera: Camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def camera_basis(camera: Camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Unit forward, right and up vectors of the camera, world space."""
     eye = np.asarray(camera.eye, dtype=np.float64)
     forward = np.asarray(camera.target, dtype=np.float64) - eye
@@ -29,7 +29,7 @@ def _basis(camera: Camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 def view_matrix(camera: Camera) -> np.ndarray:
     """``view_from_world`` as a pyrr (row-vector) 4x4 float64 matrix."""
-    forward, _, up = _basis(camera)
+    forward, _, up = camera_basis(camera)
     eye = np.asarray(camera.eye, dtype=np.float64)
     return np.asarray(Matrix44.look_at(eye, eye + forward, up), dtype=np.float64)
 
@@ -68,7 +68,7 @@ def primary_rays(camera: Camera, width: int, height: int,
     ``jitter`` (height, width, 2) in [0, 1) moves the sample inside the pixel (stratified
     anti-aliasing); without it the ray passes through the centre, as the rasterizer samples.
     """
-    forward, right, up = _basis(camera)
+    forward, right, up = camera_basis(camera)
     tan_half = math.tan(math.radians(camera.fov_y) / 2.0)
     aspect = width / height
     offset = np.full((height, width, 2), 0.5) if jitter is None else jitter
