@@ -37,10 +37,12 @@ def test01_normals_of_the_test_squares(squares):
     np.testing.assert_allclose(squares.normals, [[0, 0, 1], [0, 0, -1], [0, 1, 0]], atol=1e-12)
 
 
-@pytest.mark.parametrize("method, tol", [("raycast", 0.01), ("analytic", 0.001)])
-def test02_unit_squares_closed_form(squares, method, tol):
-    """Ray-cast within 1 % (the issue's bound); analytic within 0.1 %."""
-    F = form_factor_matrix(squares, method)
+@pytest.mark.parametrize("method, order, tol", [("raycast", 2, 0.01), ("raycast", 3, 0.001),
+                                                ("analytic", 3, 0.001)])
+def test02_unit_squares_closed_form(squares, method, order, tol):
+    """Ray-cast within 1 % with the default 2x2 receiver points (the issue's bound; 0.7 %
+    measured), within 0.1 % with 3x3; analytic within 0.1 %."""
+    F = form_factor_matrix(squares, method, order=order)
     assert F[0, 1] == pytest.approx(PARALLEL, rel=tol)
     assert F[0, 2] == pytest.approx(PERPENDICULAR, rel=tol)
     assert F[2, 0] == pytest.approx(PERPENDICULAR, rel=tol)
@@ -74,13 +76,13 @@ def box_patches():
 def test05_closed_box_row_sums_and_reciprocity(box_patches):
     """Row sums 1 in a closed room; A_i F_ij = A_j F_ji. Nothing occludes, so the ray-cast
     kernel is the exact one: every receiver point sees exactly the whole room (row sums to
-    1e-6); reciprocity errs only by the 3x3 quadrature, worst (3 %) for perpendicular
-    neighbours whose edges overlap in part, 0.13 % summed over all pairs."""
+    1e-6); reciprocity errs only by the 2x2 receiver quadrature, worst (4.7 %) for
+    perpendicular neighbours whose edges overlap in part, 0.28 % summed over all pairs."""
     F = np.stack([FormFactors(box_patches, "raycast").row(i) for i in range(len(box_patches))])
     data = heatmap_data(F)
     np.testing.assert_allclose(data["row_sums"], 1.0, atol=1e-6)
     AF = box_patches.areas[:, None] * F
-    np.testing.assert_allclose(AF, AF.T, rtol=0.05, atol=1e-12)
+    np.testing.assert_allclose(AF, AF.T, rtol=0.06, atol=1e-12)
     assert np.abs(AF - AF.T).sum() / AF.sum() < 0.005
     # The full matrix is made reciprocal; its row sums keep within the quadrature error
     full = form_factor_matrix(box_patches, "raycast")
@@ -89,15 +91,15 @@ def test05_closed_box_row_sums_and_reciprocity(box_patches):
 
 
 def test06_reciprocity_with_occlusion():
-    """With a block in the room the visible share is sampled by rays (9 receiver points x 4
+    """With a block in the room the visible share is sampled by rays (4 receiver points x 4
     rays per pair), from each side separately, so reciprocity holds only up to that sampling:
-    3.6 % summed over pairs at 59 patches (measured; bound 5 %). Away from the floor, which
+    4.2 % summed over pairs at 59 patches (measured; bound 6 %). Away from the floor, which
     the block hides in part, the room is closed: row sums 1 within 0.03."""
     patches = uniform_patches(load_preset("radiosity-leak"), 80)
     ff = FormFactors(patches, "raycast")
     F = ff.compute_rows(np.arange(len(patches)))  # each row from its own patch
     AF = patches.areas[:, None] * F
-    assert np.abs(AF - AF.T).sum() / AF.sum() < 0.05
+    assert np.abs(AF - AF.T).sum() / AF.sum() < 0.06
     off_floor = patches.centers[:, 1] > 1e-9
     np.testing.assert_allclose(F.sum(axis=1)[off_floor], 1.0, atol=0.03)
 
