@@ -34,7 +34,8 @@ def test_wheel_renders_from_any_directory(tmp_path):
     env = {**os.environ, "PYTHONPATH": str(site)}
     out = subprocess.run([sys.executable, "-c",
                           "import app, sys; from app.cli import main; print(app.__file__); "
-                          "sys.exit(main(['render', 'cornell', '-o', 'x.png', '--size', '32x32']))"],
+                          "sys.exit(main(['render', 'cornell', '-o', 'x.png', "
+                          "'--size', '32x32']))"],
                          cwd=elsewhere, env=env, capture_output=True, text=True)
     assert out.returncode == 0, out.stderr
     assert out.stdout.splitlines()[0].startswith(str(site))  # the wheel's copy, not the repo's

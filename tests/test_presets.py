@@ -92,7 +92,8 @@ def test_bad_preset_one_line_exit_2(case, tmp_path, capsys):
 def _mesh_preset(tmp_path: Path, filename: str, content: str | bytes) -> str:
     target = tmp_path / filename
     target.write_bytes(content if isinstance(content, bytes) else content.encode())
-    return _write(tmp_path, GOOD.replace('shape = "sphere"', f'shape = "mesh"\npath = "{filename}"'))
+    mesh = f'shape = "mesh"\npath = "{filename}"'
+    return _write(tmp_path, GOOD.replace('shape = "sphere"', mesh))
 
 
 @pytest.mark.parametrize("filename,content,expected", [
@@ -168,4 +169,4 @@ def test_schema_json_is_generated_from_the_model():
     from app.scene.schema import schema_text
 
     committed = (presets_dir() / "schema.json").read_text()
-    assert committed == schema_text(), "regenerate: python -m app.scene.schema > presets/schema.json"
+    assert committed == schema_text(), "run: python -m app.scene.schema > presets/schema.json"

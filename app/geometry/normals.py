@@ -91,7 +91,7 @@ def crease_corner_normals(vertices: np.ndarray, faces: np.ndarray,
     corner_face = order // 3
     wn = fn[corner_face] * weights.reshape(-1)[order][:, None]
     out = np.zeros((len(corner_vertex), 3))
-    for s, e in zip(starts, ends):
+    for s, e in zip(starts, ends, strict=True):
         group = order[s:e]
         normals_here = fn[group // 3]                     # (k, 3) face normal of each corner
         close = normals_here @ normals_here.T >= cos_limit  # (k, k) faces within the crease

@@ -79,7 +79,8 @@ class Light:
 
 @dataclass
 class Material:
-    """The lecture's coefficients; ``kd`` scales the diffuse color ``Od``, ``ks`` the specular ``Os``."""
+    """The lecture's coefficients: ``kd`` scales the diffuse color ``Od``, ``ks`` the specular
+    color ``Os``."""
 
     ka: float = spec(0.1, "float", 0.0, 1.0, doc="ambient-reflection coefficient")
     kd: float = spec(0.7, "float", 0.0, 1.0, doc="diffuse-reflection coefficient")
@@ -107,7 +108,8 @@ class Material:
 
 @dataclass
 class Object:
-    """A trimesh primitive or a mesh file, placed by scale, then rotate (XYZ, degrees), then translate."""
+    """A trimesh primitive or a mesh file, placed by scale, then rotate (XYZ, degrees), then
+    translate."""
 
     shape: str = spec("sphere", "str", SHAPES, doc="primitive or 'mesh'")
     name: str = spec("", "str", None, doc="label")

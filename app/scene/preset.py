@@ -9,11 +9,11 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
-import tomllib
 from pathlib import Path
 from typing import Any
 
 import tomli_w
+import tomllib
 
 from app.errors import ShadeLabError
 from app.resources import presets_dir
@@ -56,7 +56,8 @@ def resolve_preset(name_or_path: str) -> Path:
     candidate = presets_dir() / f"{name_or_path}.toml"
     if not candidate.is_file():
         names = ", ".join(list_presets())
-        raise ShadeLabError(f"unknown preset '{name_or_path}' (expected one of: {names}, or a path)")
+        raise ShadeLabError(f"unknown preset '{name_or_path}' "
+                            f"(expected one of: {names}, or a path)")
     return candidate
 
 
@@ -227,7 +228,7 @@ def _cross_check(scene: Scene, source: str) -> None:
             # f_att = min(1/0, 1) = 1: allowed, the clamp makes it finite (failure gallery)
             pass
     cam = scene.camera
-    if sum((a - b) ** 2 for a, b in zip(cam.eye, cam.target)) == 0.0:
+    if sum((a - b) ** 2 for a, b in zip(cam.eye, cam.target, strict=True)) == 0.0:
         raise ShadeLabError(f"{source}: key 'camera.target': expected a point other than the eye")
 
 
