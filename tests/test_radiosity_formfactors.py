@@ -107,11 +107,11 @@ def test06_reciprocity_with_occlusion():
 def test07_rows_on_demand_and_the_reciprocal_matrix(box_patches):
     """A row on demand (progressive refinement) integrates over its own patch; the full
     matrix integrates each pair over the smaller patch and is reciprocal to rounding. The
-    two agree within the quadrature error (3 % worst, see test05)."""
+    two agree within the quadrature error (5 % worst, see test05)."""
     ff = FormFactors(box_patches, "raycast")
     row = ff.row(7).copy()
     full = FormFactors(box_patches, "raycast").matrix()
-    np.testing.assert_allclose(row, full[7], rtol=0.05, atol=1e-12)
+    np.testing.assert_allclose(row, full[7], rtol=0.06, atol=1e-12)
     AF = box_patches.areas[:, None] * full
     np.testing.assert_allclose(AF, AF.T, rtol=1e-12, atol=1e-15)
 

@@ -3,8 +3,9 @@ reference, for radiosity and for the reference path tracer, in the same run; and
 to a first lit image with progressive refinement.
 
 Error metric (``image_error``): relative L1, sum |img - ref| / sum |ref|, over the pixels
-that do not see an emitter or touch one (a one-pixel ring). Both images are box-filtered
-pixels: the path tracer's jittered samples, radiosity's 4 x 4 sub-pixel centres. The light's
+that do not see an emitter or touch one (a one-pixel ring, diagonals included). Both images
+are box-filtered pixels: the path tracer's jittered samples, radiosity's 4 x 4 sub-pixel
+centres. The light's
 own pixels hold Le in both by definition; at its edges a 0.04-pixel difference in sampling
 swings those pixels (L = 20 against ~0.2 on the walls) more than all the rest of the image,
 so they would measure sampling of the light's outline, not illumination.
@@ -26,13 +27,12 @@ def emitter_ring_mask(solution, size: tuple[int, int]) -> np.ndarray:
 
     p = solution.patches
     lit = RadiositySolution(solution.scene, p, p.E).image(size, supersample=SUPERSAMPLE)
-    hit = lit.max(axis=2) > 0.0
-    ring = hit.copy()
-    ring[1:] |= hit[:-1]
-    ring[:-1] |= hit[1:]
-    ring[:, 1:] |= hit[:, :-1]
-    ring[:, :-1] |= hit[:, 1:]
-    return ~ring
+    hit = np.pad(lit.max(axis=2) > 0.0, 1)
+    ring = np.zeros_like(hit)
+    for dy in (-1, 0, 1):  # 3 x 3 dilation
+        for dx in (-1, 0, 1):
+            ring[1:-1, 1:-1] |= hit[1 + dy:hit.shape[0] - 1 + dy, 1 + dx:hit.shape[1] - 1 + dx]
+    return ~ring[1:-1, 1:-1]
 
 
 def image_error(image: np.ndarray, reference: np.ndarray, mask: np.ndarray) -> float:
