@@ -353,3 +353,30 @@ def test_view_restores_the_autosaved_session_unless_fresh_or_another_preset(tmp_
     assert name == "sphere-shading" and "red" not in other.materials
     overridden = load_scene(args("cornell", overrides=["materials.red.kd=0.5"]))[0]
     assert overridden.materials["red"].kd == 0.5
+
+
+def test_a_picklable_job_runs_in_the_worker_process_and_cancels():
+    from app.ui.jobs import iter_reference_raster
+
+    scene = load_preset("cornell")
+    runner = JobRunner()
+    try:
+        runner.start("ref", lambda: iter_reference_raster(scene, (32, 24)),
+                     call=(iter_reference_raster, scene, (32, 24)))
+        assert runner.in_process
+        runner._thread.join(60.0)
+        last = runner.snapshot()[0]
+        assert not runner.error and last.fraction == 1.0 and last.image.shape == (24, 32, 3)
+        local = list(iter_reference_raster(scene, (32, 24)))[-1].image
+        np.testing.assert_array_equal(last.image, local)  # the same numbers came across
+        big = (640, 480)  # 60 chunks of rows: the cancel lands long before the end
+        runner.start("big", lambda: None, call=(iter_reference_raster, scene, big))
+        deadline = time.perf_counter() + 30.0
+        while runner.snapshot()[0] is None and time.perf_counter() < deadline:
+            time.sleep(0.01)
+        runner.cancel(wait=True)
+        assert runner.cancelled and not runner.running
+        assert runner.snapshot()[0].fraction < 1.0
+    finally:
+        runner.shutdown()
+    assert runner.worker.process is None

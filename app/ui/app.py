@@ -29,6 +29,7 @@ ORBIT_SPEED = 0.008        # radians per pixel dragged
 ZOOM_STEP = 0.9            # eye-target distance factor per wheel notch
 CLICK_SLOP = 3.0           # pixels a click may move and still probe
 PRESENTER_SCALE = 1.8      # font scale of presenter mode
+WARM_JOBS_AT_FRAME = 60    # start the offline-job process once the window is up
 WINDOW_BG = imgui.ImVec4(0.06, 0.06, 0.06, 1.0)  # the dark theme's panel color, opaque
 
 
@@ -220,7 +221,7 @@ class Viewer:
             start_job_by_label(self.state, self.options.job)
 
     def before_exit(self) -> None:
-        self.state.job.cancel(wait=True, timeout=2.0)
+        self.state.job.shutdown()
         if self.options.autosave:
             self.autosave(force=True)
         if self.options.bench_json:
@@ -500,6 +501,10 @@ class Viewer:
         self.cpu_times.append(time.process_time())
         self.redraw_flags.append(0 if not self.redrawn else (2 if self.force_interactive else 1))
         state.frame += 1
+        if state.frame == WARM_JOBS_AT_FRAME and not (self.options.frames
+                                                      or self.options.test_function) \
+                and state.job.worker is not None:
+            state.job.worker.warm()  # after start-up: the first job then starts at once
         if self.options.bench_json and self.options.frames:
             # Phases: idle (GUI only), full-resolution redraw, interactive (drag) redraw.
             third = self.options.frames // 3

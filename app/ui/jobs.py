@@ -1,13 +1,22 @@
 """Offline renders off the UI thread: a generic runner over any ``Iterator[Progress]``.
 
+A job whose factory can be pickled (every renderer on offer) runs in a worker *process*, so
+numba compilation or a GIL-holding kernel never stalls the UI, and a cancel that does not land
+within ``KILL_AFTER`` seconds ends the process; anything else (a closure, a test's generator)
+runs in a worker thread. Either way the UI polls :meth:`JobRunner.snapshot`.
+
 The renderers (Whitted, path tracer, radiosity) are found lazily, so the viewer runs whether or
 not those layers exist yet; a missing one is listed as "not available" with the reason.
-Pure module: threads and numpy only, no GL.
+Pure module: threads, processes and numpy only, no GL.
 """
 
 from __future__ import annotations
 
 import importlib
+import multiprocessing
+import pickle
+import queue
+import sys
 import threading
 import time
 from dataclasses import dataclass
@@ -21,6 +30,98 @@ from app.scene.model import Scene
 from app.scene.preset import clone_scene
 
 JobFactory = Callable[[Scene, tuple[int, int]], Iterator[Progress]]
+KILL_AFTER = 3.0   # seconds a cancelled process job may take before its process is ended
+
+
+def _picklable(step: Progress) -> Progress:
+    """The Progress itself, or a copy without the stats entries that cannot cross processes."""
+    try:
+        pickle.dumps(step)
+        return step
+    except Exception:
+        stats = {}
+        for key, value in step.stats.items():
+            try:
+                pickle.dumps(value)
+                stats[key] = value
+            except Exception:
+                stats[key] = f"<{type(value).__name__}>"
+        return Progress(step.image, step.fraction, step.message, stats)
+
+
+def _process_main(tasks, results, cancel) -> None:
+    """The worker process: run each (job_id, factory, scene, size) task, streaming Progress."""
+    import os
+
+    parent = os.getppid()
+    while True:
+        try:
+            task = tasks.get(timeout=1.0)
+        except queue.Empty:
+            if os.getppid() != parent:
+                return  # the viewer is gone (crashed or killed): do not linger
+            continue
+        if task is None:
+            return
+        job_id, factory, scene, size = task
+        gen, error, cancelled = None, "", False
+        try:
+            gen = factory(scene, size)
+            for step in gen:
+                results.put(("progress", job_id, _picklable(step)))
+                if cancel.is_set():
+                    cancelled = True
+                    break
+        except Exception as exc:
+            error = f"{type(exc).__name__}: {exc}"
+        finally:
+            if gen is not None and hasattr(gen, "close"):
+                gen.close()
+        results.put(("done", job_id, error, cancelled))
+
+
+class WorkerProcess:
+    """One long-lived spawned process that runs jobs one at a time (started on first use)."""
+
+    def __init__(self) -> None:
+        self._mp = multiprocessing.get_context("spawn")
+        self.process = None
+        self.tasks = self.results = self.cancel = None
+
+    def ensure(self) -> None:
+        if self.process is not None and self.process.is_alive():
+            return
+        self.tasks, self.results = self._mp.Queue(), self._mp.Queue()
+        self.cancel = self._mp.Event()
+        self.process = self._mp.Process(target=_process_main, name="shadelab-jobs", daemon=True,
+                                        args=(self.tasks, self.results, self.cancel))
+        # A spawned child re-imports the parent's __main__ (here ``app/__main__.py``, which
+        # would start another viewer); hide it while the child's start-up data is taken.
+        main = sys.modules.get("__main__")
+        saved = {k: main.__dict__[k] for k in ("__spec__", "__file__") if k in main.__dict__}
+        try:
+            main.__spec__ = None
+            main.__dict__.pop("__file__", None)
+            self.process.start()
+        finally:
+            main.__dict__.update(saved)
+
+    def warm(self) -> None:
+        """Start the process and import the renderers in it ahead of the first job."""
+        self.ensure()
+        self.tasks.put((0, warm_up, None, None))
+
+    def kill(self) -> None:
+        if self.process is not None and self.process.is_alive():
+            self.process.terminate()
+            self.process.join(2.0)
+        self.process = None
+
+    def shutdown(self) -> None:
+        if self.process is not None and self.process.is_alive():
+            self.tasks.put(None)
+            self.process.join(1.0)
+        self.kill()
 
 
 class JobRunner:
@@ -30,7 +131,11 @@ class JobRunner:
     progress contract asks (chunks stay under 0.2 s, so a cancel lands within one chunk).
     """
 
-    def __init__(self) -> None:
+    def __init__(self, use_process: bool = True) -> None:
+        self.use_process = use_process
+        self.worker = WorkerProcess() if use_process else None
+        self.in_process = False         # the current job runs in the worker process
+        self._job_id = 0
         self.name = ""
         self.latest: Progress | None = None
         self.error = ""
@@ -54,15 +159,55 @@ class JobRunner:
             return 0.0
         return (self.finished or time.perf_counter()) - self.started
 
-    def start(self, name: str, make: Callable[[], Iterator[Progress]]) -> None:
-        """Start ``make()``'s generator in a worker; a running job is cancelled first."""
+    def start(self, name: str, make: Callable[[], Iterator[Progress]],
+              call: tuple | None = None) -> None:
+        """Start a job; a running one is cancelled first.
+
+        ``call`` = (factory, scene, size) runs ``factory(scene, size)`` in the worker process
+        when it pickles; otherwise ``make()``'s generator runs in a thread.
+        """
         self.cancel(wait=True)
         self.name, self.latest, self.error, self.cancelled = name, None, "", False
         self.started, self.finished = time.perf_counter(), 0.0
         self._cancel.clear()
-        self._thread = threading.Thread(target=self._work, args=(make,), daemon=True,
+        self._job_id += 1
+        self.in_process = bool(self.use_process and call is not None and _pickles(call))
+        if self.in_process:
+            self.worker.ensure()
+            self.worker.cancel.clear()
+            self.worker.tasks.put((self._job_id, *call))
+            target, args = self._listen, (self._job_id,)
+        else:
+            target, args = self._work, (make,)
+        self._thread = threading.Thread(target=target, args=args, daemon=True,
                                         name=f"shadelab-job-{name}")
         self._thread.start()
+
+    def _listen(self, job_id: int) -> None:
+        """Relay the worker process's Progress; end it if a cancel does not land in time."""
+        worker = self.worker
+        while True:
+            if self._cancel.is_set() and time.perf_counter() - self.cancel_requested > KILL_AFTER:
+                worker.kill()
+                self.cancelled = True
+                break
+            if not worker.process or not worker.process.is_alive():
+                self.error = self.error or "the job's worker process ended unexpectedly"
+                break
+            try:
+                message = worker.results.get(timeout=0.05)
+            except queue.Empty:
+                continue
+            if message[1] != job_id:
+                continue  # a late message of an earlier job
+            if message[0] == "progress":
+                with self._lock:
+                    self.latest = message[2]
+                    self.version += 1
+            else:
+                self.error, self.cancelled = message[2], message[3]
+                break
+        self.finished = time.perf_counter()
 
     def _work(self, make: Callable[[], Iterator[Progress]]) -> None:
         gen = None
@@ -86,8 +231,16 @@ class JobRunner:
         if self.running and not self._cancel.is_set():
             self.cancel_requested = time.perf_counter()
         self._cancel.set()
+        if self.in_process and self.worker.cancel is not None:
+            self.worker.cancel.set()
         if wait and self._thread is not None:
             self._thread.join(timeout)
+
+    def shutdown(self) -> None:
+        """Cancel the job and end the worker process (the viewer is closing)."""
+        self.cancel(wait=True, timeout=1.0)
+        if self.worker is not None:
+            self.worker.shutdown()
 
     def snapshot(self) -> tuple[Progress | None, int]:
         with self._lock:
@@ -155,42 +308,67 @@ def _lookup(module: str, names: tuple[str, ...]):
     return None, f"{module} has none of {', '.join(names)}"
 
 
-def _raytrace_factory():
-    for module in ("app.raytrace", "app.raytrace.whitted", "app.raytrace.tracer"):
-        fn, reason = _lookup(module, ("iter_whitted", "iter_raytrace"))
+def _pickles(value) -> bool:
+    try:
+        pickle.dumps(value)
+        return True
+    except Exception:
+        return False
+
+
+WHITTED = (("app.raytrace", "app.raytrace.whitted", "app.raytrace.tracer"),
+           ("iter_whitted", "iter_raytrace"))
+PATHTRACE = (("app.raytrace.pathtrace",), ("iter_pathtrace",))
+RADIOSITY = (("app.radiosity", "app.radiosity.solver"), ("iter_radiosity",))
+
+
+def _find(spec) -> tuple[Callable | None, str]:
+    modules, names = spec
+    reason = ""
+    for module in modules:
+        fn, reason = _lookup(module, names)
         if fn is not None:
             return fn, ""
     return None, reason
 
 
-def _pathtrace_factory(seed: int = 1):
+def warm_up(scene, size) -> Iterator[Progress]:
+    """Import every renderer (numba caches load, embree starts); yields nothing."""
+    for modules, _ in (WHITTED, PATHTRACE, RADIOSITY):
+        for module in modules:
+            try:
+                importlib.import_module(module)
+            except ImportError:
+                pass
+    return iter(())
+
+
+# Module-level factories (picklable by reference, so they run in the worker process).
+def run_whitted(scene: Scene, size: tuple[int, int]) -> Iterator[Progress]:
+    return _find(WHITTED)[0](scene, size)
+
+
+def run_pathtrace(scene: Scene, size: tuple[int, int], seed: int = 1) -> Iterator[Progress]:
     """The path tracer at the scene's samples per pixel (the panel sets them)."""
-    fn, reason = _lookup("app.raytrace.pathtrace", ("iter_pathtrace",))
-    if fn is None:
-        return None, reason
-    return (lambda scene, size: fn(scene, size, max(scene.raytrace.spp, 1), seed)), ""
+    return _find(PATHTRACE)[0](scene, size, max(scene.raytrace.spp, 1), seed)
 
 
-def _radiosity_factory():
-    """Radiosity; GPU hemicube form factors would need a GL context in the worker thread
-    (the viewer's context belongs to the UI thread), so the viewer asks for ray-cast ones."""
-    for module in ("app.radiosity", "app.radiosity.solver"):
-        fn, reason = _lookup(module, ("iter_radiosity",))
-        if fn is not None:
-            def make(scene, size, fn=fn):
-                method = "raycast" if scene.radiosity.form_factors == "hemicube" else None
-                return fn(scene, size, form_factors=method)
-            return make, ""
-    return None, reason
+def run_radiosity(scene: Scene, size: tuple[int, int]) -> Iterator[Progress]:
+    """Radiosity with ray-cast form factors: the GPU hemicube would need a GL context of its
+    own in the worker (the viewer's context belongs to the UI thread)."""
+    method = "raycast" if scene.radiosity.form_factors == "hemicube" else None
+    return _find(RADIOSITY)[0](scene, size, form_factors=method)
 
 
 def available_jobs() -> list[JobKind]:
     """The offline renderers, each with a factory or the reason it is missing."""
     kinds = [JobKind("Reference raster (numpy)", iter_reference_raster)]
-    for label, (make, reason) in (("Whitted ray tracer", _raytrace_factory()),
-                                  ("Path tracer (reference GI)", _pathtrace_factory()),
-                                  ("Radiosity", _radiosity_factory())):
-        kinds.append(JobKind(label, make, reason, "gouraud" if label == "Radiosity" else "phong"))
+    for label, spec, run in (("Whitted ray tracer", WHITTED, run_whitted),
+                             ("Path tracer (reference GI)", PATHTRACE, run_pathtrace),
+                             ("Radiosity", RADIOSITY, run_radiosity)):
+        fn, reason = _find(spec)
+        kinds.append(JobKind(label, run if fn is not None else None, reason,
+                             "gouraud" if label == "Radiosity" else "phong"))
     return kinds
 
 

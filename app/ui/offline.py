@@ -47,7 +47,7 @@ def start_job(state: AppState, index: int) -> None:
     state.job_kind, state.job_version, state.job_compare = index, -1, None
     state.job_scene, state.job_size_px = scene, size
     state.ray_tree = state.ray_tree_pixel = None
-    state.job.start(kind.label, lambda: kind.make(scene, size))
+    state.job.start(kind.label, lambda: kind.make(scene, size), call=(kind.make, scene, size))
 
 
 def start_job_by_label(state: AppState, label: str) -> None:
