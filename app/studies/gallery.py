@@ -104,7 +104,8 @@ GALLERY: list[GalleryCase] = [
     GalleryCase(
         "degenerate-triangles", "fail-degenerate", (), "raster:gouraud",
         "A zero-area triangle has no normal. ShadeLab gives it a zero face normal, falls back to "
-        "the face normal for zero-length vertex normals, shades a zero normal as unlit (no NaN), "
+        "the face normal for zero-length vertex normals (the raster draws no pixel of a "
+        "zero-area triangle; the numpy reference shades a zero normal as unlit, never NaN), "
         "and refuses mesh files with degenerate triangles with a one-line error.",
         T + "test11_degenerate_triangles"),
     GalleryCase(
@@ -133,8 +134,8 @@ GALLERY: list[GalleryCase] = [
         ("materials.paint.kd=1", "materials.paint.ks=1", "materials.paint.Od=1,1,1"),
         "raster:phong",
         "kd + ks > 1 reflects more light than arrives: the Phong model does not conserve "
-        "energy, and the highlight saturates. ShadeLab allows it for the lecture; radiosity and "
-        "the path tracer use only rho = kd Od, which stays below 1.",
+        "energy, and the highlight saturates. ShadeLab allows it for the lecture; radiosity "
+        "uses only rho = kd Od and refuses a system whose rho F would not converge.",
         T + "test16_kd_plus_ks_over_one"),
 ]
 
