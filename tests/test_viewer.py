@@ -344,12 +344,13 @@ def test_view_restores_the_autosaved_session_unless_fresh_or_another_preset(tmp_
     def args(preset=None, fresh=False, overrides=()):
         return argparse.Namespace(preset=preset, fresh=fresh, set=list(overrides))
 
-    restored, source = load_scene(args())
-    assert source == "cornell" and restored.materials["red"].kd == 0.125
+    restored, source, was_restored = load_scene(args())
+    assert source == "cornell" and restored.materials["red"].kd == 0.125 and was_restored
     assert "restored the autosaved session" in capsys.readouterr().out
     assert load_scene(args("cornell"))[0].materials["red"].kd == 0.125
     assert load_scene(args("cornell", fresh=True))[0].materials["red"].kd == 1.0
-    other, name = load_scene(args("sphere-shading"))
+    other, name, was_restored = load_scene(args("sphere-shading"))
+    assert not was_restored
     assert name == "sphere-shading" and "red" not in other.materials
     overridden = load_scene(args("cornell", overrides=["materials.red.kd=0.5"]))[0]
     assert overridden.materials["red"].kd == 0.5

@@ -56,7 +56,7 @@ def _pixel(text: str, flag: str) -> tuple[int, int]:
 
 
 def load_scene(args: argparse.Namespace):
-    """The scene to open: the autosaved session if it matches, else the preset."""
+    """(scene, source, restored): the autosaved session if it matches, else the preset."""
     from app.scene.preset import load_preset
     from app.ui.state import load_session
 
@@ -65,9 +65,9 @@ def load_scene(args: argparse.Namespace):
         if session is not None and args.preset in (None, session[1]):
             print(f"shadelab: restored the autosaved session of '{session[1]}' "
                   f"(--fresh to start from the preset)")
-            return session
+            return (*session, True)
     name = args.preset or DEFAULT_PRESET
-    return load_preset(name, args.set), name
+    return load_preset(name, args.set), name, False
 
 
 def run_view(args: argparse.Namespace) -> int:
@@ -81,7 +81,7 @@ def run_view(args: argparse.Namespace) -> int:
     ray_tree = _pixel(args.ray_tree, "--ray-tree") if args.ray_tree else None
     if args.frames < 0:
         raise ShadeLabError(f"--frames {args.frames}: expected a count >= 0")
-    scene, source = load_scene(args)
+    scene, source, restored = load_scene(args)
     from app.geometry.mesh import scene_meshes
 
     scene_meshes(scene)  # a broken mesh file fails here, with its one-line reason
@@ -89,6 +89,8 @@ def run_view(args: argparse.Namespace) -> int:
     from app.ui.state import AppState
 
     state = AppState.from_scene(scene, source)
+    if restored:
+        state.status = f"restored the autosaved session of '{source}'"
     state.compare, state.diff_enabled = args.compare, args.diff
     state.presenter, state.show_help = args.presenter, args.help_overlay
     state.show_wireframe, state.show_normals = args.wireframe, args.normals

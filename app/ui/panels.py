@@ -370,9 +370,12 @@ def draw_equation_panel(state: AppState) -> bool:
             _term_row("GPU drew", result.gpu)
         imgui.end_table()
     for i, t in enumerate(result.terms.lights):
+        name = lights[i].name or f"light {i}"
         if lights[i].attenuation == "lecture":
-            imgui.text(f"{lights[i].name or f'light {i}'}: min(1/(c1 + c2 d + c3 d^2), 1) clamp "
+            imgui.text(f"{name}: min(1/(c1 + c2 d + c3 d^2), 1) clamp "
                        + ("ACTIVE (f_att = 1)" if bool(t.clamp_active) else "not active"))
+        else:
+            imgui.text(f"{name}: attenuation '{lights[i].attenuation}' (no min(., 1) clamp)")
     if result.gpu is not None:
         err = float(np.max(np.abs(result.gpu - result.reference)))
         agree = err <= 1e-4 * max(1.0, float(np.max(np.abs(result.reference))))
