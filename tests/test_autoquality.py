@@ -71,6 +71,8 @@ def test06_render_error_flag(gl_ctx, tmp_path, capsys):
                  "--shading", "phong", "--error", "0.01"]) == 0
     text = capsys.readouterr().out
     assert "auto quality: objects.0" in text and "<= 0.01" in text and out.is_file()
+    assert main(["render", "cornell", "-o", str(out), "--size", "16x16", "--error", "0.01"]) == 0
+    assert "no round sphere to tessellate" in capsys.readouterr().out
 
 
 @pytest.mark.parametrize("value", ["0", "-0.5", "nan", "abc"])

@@ -110,4 +110,7 @@ def auto_tessellate(scene, shading: str, size: tuple[int, int], budget: float,
         verdict = "<=" if choice.met else "> (best reachable)"
         lines.append(f"auto quality: objects.{index} ({obj.name or obj.shape}) subdivisions "
                      f"{obj.subdivisions}: relMSE {choice.point.error:.3g} {verdict} {budget:g}")
+    if not lines:
+        lines.append("auto quality: no round sphere to tessellate (only spheres have an exact "
+                     "reference); rendering as the preset says")
     return lines

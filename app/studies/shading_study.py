@@ -76,13 +76,19 @@ def exact_sphere_image(scene: Scene, index: int, size: tuple[int, int],
 
 
 def isolated(scene: Scene, index: int, level: int | None = None) -> Scene:
-    """A copy of the scene holding only object ``index`` (at subdivision ``level``)."""
+    """A copy of the scene holding only object ``index`` (at subdivision ``level``), drawn
+    the way the exact reference shades it: opaque, no texture, bump, shadows or painter."""
     out = copy.deepcopy(scene)
     obj = out.objects[index]
     if level is not None:
         obj.subdivisions = level
     out.objects = [obj]
     out.render.background = (0.0, 0.0, 0.0)
+    out.render.shadows = "none"            # one object: nothing to cast on it
+    out.render.visibility = "zbuffer"
+    material = out.materials[obj.material]
+    material.texture, material.bump = "", ""  # the exact reference shades plain Od,
+    material.kt = 0.0                         # opaque (no blend with what lies behind)
     return out
 
 
