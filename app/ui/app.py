@@ -602,7 +602,7 @@ def _docking(viewer: Viewer) -> hello_imgui.DockingParams:
     params.docking_splits = [
         split("MainDockSpace", "LeftSpace", imgui.Dir.left, 0.24),
         split("MainDockSpace", "RightSpace", imgui.Dir.right, 0.36),
-        split("RightSpace", "RightBottom", imgui.Dir.down, 0.45),
+        split("RightSpace", "RightBottom", imgui.Dir.down, 0.40),
     ]
     p = viewer.panel
     params.dockable_windows = [
