@@ -93,7 +93,7 @@ def auto_tessellate(scene, shading: str, size: tuple[int, int], budget: float,
     :mod:`app.studies.shading_study`) at the render's aspect, capped at ``max_side`` pixels;
     the cost is the triangle count. Returns one report line per sphere.
     """
-    from app.studies.shading_study import LEVELS, measure_sphere, sphere_of
+    from app.studies.shading_study import COLUMNS, LEVELS, measure_sphere, sphere_of
 
     budget = check_budget(budget)
     scale = min(1.0, max_side / max(size))
@@ -103,8 +103,7 @@ def auto_tessellate(scene, shading: str, size: tuple[int, int], budget: float,
         if sphere_of(obj) is None:
             continue
         rows = measure_sphere(scene, index, shading, probe, LEVELS, specular, repeats=1)
-        records = [dict(zip(("method", "level", "triangles", "time_ms", "mae", "rmse",
-                             "relmse", "silhouette"), row, strict=False)) for row in rows]
+        records = [dict(zip(COLUMNS, row, strict=True)) for row in rows]
         choice = choose_setting(front_from_rows(records, ("level",), "triangles"), budget)
         obj.subdivisions = int(choice.point.setting["level"])
         verdict = "<=" if choice.met else "> (best reachable)"

@@ -21,7 +21,8 @@ from app.studies.result import StudyResult, study_clock
 
 LEVELS = tuple(range(6))                 # icosphere subdivision levels studied
 METHODS = ("flat", "gouraud", "phong")   # raster shading modes
-COLUMNS = ["method", "level", "triangles", "time_ms", "mae", "rmse", "relmse", "silhouette"]
+COLUMNS = ["method", "level", "triangles", "time_ms", "mae", "rmse", "relmse", "silhouette",
+           "relmse_both"]
 
 
 def study_scene() -> Scene:
@@ -151,7 +152,7 @@ def measure_sphere(scene: Scene, index: int, shading: str, size: tuple[int, int]
         errors = metrics.all_metrics(image, reference, mask)
         triangles = 20 * 4 ** level
         rows.append([shading, level, triangles, ms, errors["mae"], errors["rmse"],
-                     errors["relmse"], silhouette])
+                     errors["relmse"], silhouette, metrics.relmse(image, reference, both)])
     return rows
 
 
@@ -172,7 +173,7 @@ def run_shading(quick: bool = False) -> StudyResult:
         label="level",
         notes=["reference: exact ray-sphere hit, exact normal, app.shading.reference.shade",
                "error on pixels covered by both, less a 1-px border; 'silhouette' = share covered "
-               "by one only",
+               "by one only; 'relmse_both' = relMSE on every pixel covered by both",
                "time: best of several GL render + readback, CPU time of the process (llvmpipe's "
                "threads included; app.studies.result.study_clock)"],
         extra={"triangles": by_triangles})
