@@ -147,14 +147,31 @@ def _unoccluded(rows, polygons, normals, recv, eps, areas, half):
 
 
 @numba.njit(cache=True)
+def _wallace(x0, x1, x2, ni, y0, y1, y2, nj, da):
+    """Wallace's disk-approximation weight of the ray x -> y, and the ray's direction."""
+    d0, d1, d2 = y0 - x0, y1 - x1, y2 - x2
+    r2 = d0 * d0 + d1 * d1 + d2 * d2
+    inv = 1.0 / math.sqrt(max(r2, 1e-300))
+    ci = max(0.0, (d0 * ni[0] + d1 * ni[1] + d2 * ni[2]) * inv)
+    cj = max(0.0, -(d0 * nj[0] + d1 * nj[1] + d2 * nj[2]) * inv)
+    return ci * cj * da / (math.pi * r2 + da), d0, d1, d2
+
+
+@numba.njit(cache=True)
 def _build_rays(pairs, recv, src, src_w, normals, areas, rays, eps):
-    """Ray origins, directions (to the sample, t in [0, 1]) and Wallace weights per pair."""
+    """Ray origins, directions (to the sample, t in [0, 1]) and Wallace weights per pair.
+
+    Each receiver point aims its ``rays`` rays at source samples it can see at all (in front
+    of both patches), spread over them by a rotating stride; a point that sees none of them
+    gets weights 0 (its visibility is then taken as 1: the kernel there is a sliver).
+    """
     k_count = recv.shape[1]
     s_count = src.shape[1]
     total = len(pairs) * k_count * rays
     origins = np.empty((total, 3), np.float32)
     dirs = np.empty((total, 3), np.float32)
-    weights = np.empty(total)
+    weights = np.zeros(total)
+    front = np.empty(s_count, np.int64)
     r = 0
     for p in range(len(pairs)):
         i, j = pairs[p, 0], pairs[p, 1]
@@ -162,18 +179,21 @@ def _build_rays(pairs, recv, src, src_w, normals, areas, rays, eps):
             x0 = recv[i, k, 0] + eps * normals[i, 0]
             x1 = recv[i, k, 1] + eps * normals[i, 1]
             x2 = recv[i, k, 2] + eps * normals[i, 2]
+            count = 0
+            for ell in range(s_count):
+                w, _, _, _ = _wallace(x0, x1, x2, normals[i], src[j, ell, 0], src[j, ell, 1],
+                                      src[j, ell, 2], normals[j], areas[j] * src_w[j, ell])
+                if w > 0.0:
+                    front[count] = ell
+                    count += 1
             for q in range(rays):
-                ell = (k * rays + q) % s_count
-                d0 = src[j, ell, 0] + eps * normals[j, 0] - x0
-                d1 = src[j, ell, 1] + eps * normals[j, 1] - x1
-                d2 = src[j, ell, 2] + eps * normals[j, 2] - x2
-                r2 = d0 * d0 + d1 * d1 + d2 * d2
-                inv = 1.0 / math.sqrt(max(r2, 1e-300))
-                ci = max(0.0, (d0 * normals[i, 0] + d1 * normals[i, 1] + d2 * normals[i, 2]) * inv)
-                cj = max(0.0, -(d0 * normals[j, 0] + d1 * normals[j, 1]
-                                + d2 * normals[j, 2]) * inv)
-                da = areas[j] * src_w[j, ell]
-                weights[r] = ci * cj * da / (math.pi * r2 + da) + 1e-300
+                ell = front[(k * rays + q) % count] if count else (k * rays + q) % s_count
+                w, d0, d1, d2 = _wallace(x0, x1, x2, normals[i],
+                                         src[j, ell, 0] + eps * normals[j, 0],
+                                         src[j, ell, 1] + eps * normals[j, 1],
+                                         src[j, ell, 2] + eps * normals[j, 2], normals[j],
+                                         areas[j] * src_w[j, ell])
+                weights[r] = w if count else 0.0
                 origins[r, 0], origins[r, 1], origins[r, 2] = x0, x1, x2
                 dirs[r, 0], dirs[r, 1], dirs[r, 2] = d0, d1, d2
                 r += 1
@@ -344,8 +364,9 @@ class FormFactors:
         hit = self._occluded(origins, dirs)
         k_count = self._recv.shape[1]
         weights = weights.reshape(len(pairs), k_count, self.rays)
-        seen = np.where(hit.reshape(weights.shape), 0.0, weights)
-        vis[a, j] = seen.sum(axis=2) / weights.sum(axis=2)
+        seen = np.where(hit.reshape(weights.shape), 0.0, weights).sum(axis=2)
+        total = weights.sum(axis=2)
+        vis[a, j] = np.where(total > 0.0, seen / np.maximum(total, 1e-300), 1.0)
         return vis
 
     def _occluders(self):

@@ -188,7 +188,9 @@ def uniform_patches(scene: Scene, count: int) -> PatchSet:
             lo = mid
         else:
             hi = mid
-    h = hi
+    # Counts jump as grids gain a row: take the side of the jump closer to the target
+    h = lo if abs(_count_for(surfaces, lo) - count) < abs(_count_for(surfaces, hi) - count) \
+        else hi
     leaves = []
     for index, s in enumerate(surfaces):
         if s.kind == "quad":

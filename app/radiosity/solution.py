@@ -45,6 +45,14 @@ class RadiositySolution:
     patches: PatchSet
     B: np.ndarray
     stats: dict = field(default_factory=dict)
+    form_factors: FormFactors | None = None  # the rows computed so far (heat map, teaching)
+
+    def form_factor_matrix(self) -> np.ndarray:
+        """(N, N) F of this solution's patches (computed now where rows are missing)."""
+        if self.form_factors is None:
+            self.form_factors = FormFactors(self.patches, self.stats.get("form_factors",
+                                                                         "raycast"))
+        return self.form_factors.matrix()
 
     @property
     def radiance(self) -> np.ndarray:
@@ -242,6 +250,7 @@ def _solve_stage(scene, mesh, method, solver, resolution, size, image_every, sta
     value = last.unshot if np.isnan(last.residual) else last.residual
     stats["converged"] = bool(value <= settings.tolerance) or solver == "direct"
     B = last.display_B(mesh.rho).copy()
+    stats["_form_factors"] = ff
     if final:
         yield from _finish(scene, mesh, B, stats, size, start)
     return B
@@ -250,7 +259,8 @@ def _solve_stage(scene, mesh, method, solver, resolution, size, image_every, sta
 def _finish(scene, mesh, B, stats, size, start) -> Iterator[Progress]:
     stats["patches"] = len(mesh)
     stats["total_s"] = time.perf_counter() - start
-    solution = RadiositySolution(scene, mesh, B, stats)
+    ff = stats.pop("_form_factors", None)
+    solution = RadiositySolution(scene, mesh, B, stats, ff)
     stats["solution"] = solution
     image = solution.image(size) if size is not None else None
     yield Progress(image, 1.0, f"done: {len(mesh)} patches", stats)
