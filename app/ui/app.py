@@ -282,10 +282,10 @@ class Viewer:
     def frame_key(self, size: tuple[int, int]) -> tuple:
         """Everything the viewport image depends on; an unchanged key reuses the last image."""
         s = self.state
-        probe_id = id(s.probe) if s.probe is not None else None
+        probe_id = s.probe_version
         return (repr(s.scene), size, s.compare, s.diff_enabled, s.diff_pair, s.diff_scale,
-                s.show_wireframe, s.show_normals, s.normal_length, probe_id, id(s.ray_tree),
-                s.show_radiosity and id(s.radiosity_soup))
+                s.show_wireframe, s.show_normals, s.normal_length, probe_id, s.overlay_version,
+                s.show_radiosity)
 
     def unchanged(self, size: tuple[int, int]) -> bool:
         """True when the last image is still right (idle frames only redraw the GUI)."""
@@ -379,6 +379,7 @@ class Viewer:
         if shown is None or not (0 <= shown[0] < display_size[0]
                                  and 0 <= shown[1] < display_size[1]):
             state.probe = None
+            state.probe_version += 1
             return  # (kept requested: the layout may still be settling)
         pixel = (min(int(shown[0] * size[0] / display_size[0]), size[0] - 1),
                  min(int(shown[1] * size[1] / display_size[1]), size[1] - 1))
@@ -387,6 +388,7 @@ class Viewer:
         if result is not None and not state.show_radiosity:
             result.gpu = self.viewport.read_pixel("main", pixel)
         state.probe = result
+        state.probe_version += 1
         if result is None:
             state.status = f"pixel {pixel}: background (no surface)"
 

@@ -47,6 +47,7 @@ def start_job(state: AppState, index: int) -> None:
     state.job_kind, state.job_version, state.job_compare = index, -1, None
     state.job_scene, state.job_size_px = scene, size
     state.ray_tree = state.ray_tree_pixel = None
+    state.overlay_version += 1
     state.job.start(kind.label, lambda: kind.make(scene, size), call=(kind.make, scene, size))
 
 
@@ -93,6 +94,7 @@ def _take_solution(state: AppState, latest) -> None:
         from app.ui.overlays import radiosity_soup
 
         state.radiosity_soup = radiosity_soup(solution.display_meshes())
+        state.overlay_version += 1
 
 
 def _show(state: AppState, key: str, caption: str, width: float) -> tuple[int, int] | None:
@@ -125,6 +127,7 @@ def trace_tree(state: AppState, pixel: tuple[int, int]) -> None:
     try:
         state.ray_tree = trace_pixel_tree(state.job_scene, state.job_size_px, *pixel)
         state.ray_tree_pixel = pixel
+        state.overlay_version += 1
     except Exception as exc:  # shown in the app; the session goes on
         state.error = f"ray tree of pixel {pixel}: {exc}"
 
@@ -137,6 +140,7 @@ def draw_ray_tree(state: AppState) -> None:
                f"total {_rgb(root.total())})")
     if imgui.small_button("Clear ray tree"):
         state.ray_tree = None
+        state.overlay_version += 1
         return
     flags = imgui.TableFlags_.borders | imgui.TableFlags_.row_bg | imgui.TableFlags_.scroll_y
     if imgui.begin_table("raytree", 4, flags, imgui.ImVec2(0, 160)):

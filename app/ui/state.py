@@ -129,6 +129,7 @@ class AppState:
     probe_pixel: tuple[int, int] | None = None
     probe: Any = None                 # app.ui.probe.ProbeResult
     probe_requested: bool = False
+    probe_version: int = 0            # bumped on every new probe result
     # Messages
     error: str = ""                   # shown in the app (bad preset, bad mesh...)
     status: str = ""                  # last action ("saved ...", "screenshot ...")
@@ -158,6 +159,7 @@ class AppState:
     ray_tree_pixel: Any = None        # (x, y) in the job image
     radiosity_soup: Any = None        # (3F, 6) float32 solved display triangles (radiance)
     show_radiosity: bool = False      # draw the radiosity solution instead of the raster
+    overlay_version: int = 0          # bumped when the ray tree or radiosity solution changes
 
     @classmethod
     def from_scene(cls, scene: Scene, source: str, **kwargs) -> "AppState":
