@@ -201,8 +201,11 @@ def _draw_attenuation_plot(state: AppState, index: int, light: Light) -> None:
             implot.setup_axis_scale(implot.ImAxis_.y1, implot.Scale_.log10)
         implot.plot_line("f_att", d, f)
         probe = state.probe
-        if probe is not None and index < len(probe.terms.lights):
-            implot.plot_inf_lines("probe d", np.array([float(probe.terms.lights[index].distance)]))
+        active = [i for i, other in enumerate(state.scene.lights) if other.enabled]
+        if probe is not None and index in active \
+                and active.index(index) < len(probe.terms.lights):
+            term = probe.terms.lights[active.index(index)]
+            implot.plot_inf_lines("probe d", np.array([float(term.distance)]))
         implot.end_plot()
 
 
@@ -353,7 +356,7 @@ def draw_equation_panel(state: AppState) -> bool:
         terms = result.terms
         _term_row("Le (emission)", terms.emission)
         _term_row("ambient Ia ka Od", terms.ambient)
-        for i, t in enumerate(terms.lights):
+        for i, t in enumerate(terms.lights[:len(lights)]):
             name = lights[i].name or f"light {i}"
             n_dot_l = float(np.dot(result.normal, t.to_light))
             spec_cos = float(np.dot(result.normal if blinn else result.reflected(i),
@@ -369,7 +372,7 @@ def draw_equation_panel(state: AppState) -> bool:
         if result.gpu is not None:
             _term_row("GPU drew", result.gpu)
         imgui.end_table()
-    for i, t in enumerate(result.terms.lights):
+    for i, t in enumerate(result.terms.lights[:len(lights)]):
         name = lights[i].name or f"light {i}"
         if lights[i].attenuation == "lecture":
             imgui.text(f"{name}: min(1/(c1 + c2 d + c3 d^2), 1) clamp "
