@@ -7,12 +7,13 @@ Le by definition, and its edge pixels, 100 times brighter than the walls, measur
 each samples the light's outline). Radiosity is drawn with 4 x 4 sub-pixels per pixel, the
 box filter the path tracer's jittered samples make.
 
-Bound: 12 %. Measured 8.0 % and 8.2 % (path-tracer seeds 0 and 1) at 24 x 24 pixels, 512
+Bound: 12 %. Measured 8.3 % and 8.5 % (path-tracer seeds 0 and 1) at 24 x 24 pixels, 512
 samples per pixel and 400 uniform patches. About 3 % of it is the reference's own noise (two
 512-spp images differ by ~4 %); the rest is radiosity's discretization: patches ~69 mm wide
-interpolated across shadow edges and room corners, a bias of -4 % in mean radiance that
-shrinks with more patches (-2.4 % at 1200). Wrong units (a factor pi), missing occlusion or
-an image one pixel off each exceed the bound (the last is checked here).
+interpolated across shadow edges and room corners, with a bias of -4.3 % to -5.1 % in mean
+radiance (about 1 % of it from the Gouraud reconstruction, the rest from the patch solution;
+it shrinks with more patches). Wrong units (a factor pi: 200 %), missing occlusion or an
+image one pixel off (24 %) each exceed the bound (the last is checked here).
 """
 
 from __future__ import annotations
@@ -44,10 +45,10 @@ def test01_cornell_radiosity_matches_the_path_tracer(images):
 
 
 def test02_energy_balance(images):
-    """Mean radiance away from the light: within 6 % per channel (measured -4 %..-4.6 %)."""
+    """Mean radiance away from the light: within 7 % per channel (measured -4.3 %..-5.1 %)."""
     reference, image, mask = images
     ratio = image[mask].mean(axis=0) / reference[mask].mean(axis=0)
-    np.testing.assert_allclose(ratio, 1.0, atol=0.06)
+    np.testing.assert_allclose(ratio, 1.0, atol=0.07)
 
 
 def test03_the_bound_catches_a_one_pixel_shift(images):

@@ -142,7 +142,12 @@ def _unoccluded(rows, polygons, normals, recv, eps, areas, half):
             if j == i or not _faces(polygons[i], normals[i], polygons[j], normals[j], eps):
                 continue
             for k in range(k_count):
-                out[a, j, k] = _point_polygon(recv[i, k], normals[i], polygons[j], eps, buf)
+                # One-sided patches: a point behind j's plane sees only its back
+                ahead = ((recv[i, k, 0] - polygons[j, 0, 0]) * normals[j, 0]
+                         + (recv[i, k, 1] - polygons[j, 0, 1]) * normals[j, 1]
+                         + (recv[i, k, 2] - polygons[j, 0, 2]) * normals[j, 2])
+                if ahead > eps:
+                    out[a, j, k] = _point_polygon(recv[i, k], normals[i], polygons[j], eps, buf)
     return out
 
 
