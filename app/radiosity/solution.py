@@ -165,6 +165,8 @@ def _refine_candidates(patches: PatchSet, radiance: np.ndarray, splits: int) -> 
             score[k] = np.abs(y[ids] - luminance[k]).max() / scale * patches.areas[k]
     splittable = (patches.rects[:, 0] >= 0) & ((patches.rects[:, 2] - patches.rects[:, 0]) > 1)
     score[~splittable | ~lit] = 0.0
+    if splits <= 0:
+        return np.zeros(0, np.int64)
     order = np.argsort(-score)
     mean_area = float(patches.areas.mean())
     return order[:splits][score[order[:splits]] > REFINE_CONTRAST * mean_area]
@@ -214,7 +216,8 @@ def iter_radiosity(scene: Scene, size: tuple[int, int] | None = None, patches: i
         if stage == stages - 1:
             break
         budget = count if stage == stages - 2 else len(mesh) + (count - len(mesh)) // 2
-        chosen = _refine_candidates(mesh, B / math.pi, (budget - len(mesh)) // 3)
+        splits = (budget - len(mesh)) // 3
+        chosen = _refine_candidates(mesh, B / math.pi, splits) if splits > 0 else []
         if len(chosen) == 0:  # flat everywhere: the coarse mesh is the answer
             stats["refined_out"] = True
             yield from _finish(scene, mesh, B, stats, size, start)
