@@ -129,6 +129,16 @@ def test_start_and_cancel_a_job_while_the_ui_keeps_drawing(xdisplay, tmp_path):
     assert r["reference_done"] and r["reference_rmse"] < 1e-4
 
 
+def test_every_panel_and_shortcut_without_errors(xdisplay, tmp_path):
+    r = run_scenario("smoke", xdisplay, tmp_path)
+    assert r["light"] == ["spot", "lecture", 2.0]
+    assert r["segments"] == 4 and r["uploaded_keys_changed"] == [0]  # only the floor re-uploaded
+    assert r["toggles"] == {"compare": True, "diff_enabled": True, "show_wireframe": True,
+                            "show_normals": True, "presenter": True, "show_help": True}
+    assert r["after_toggles"] == {k: False for k in r["toggles"]}
+    np.testing.assert_allclose(r["spot_gpu"], r["spot_reference"], rtol=1e-4, atol=1e-6)
+
+
 # ---------------------------------------------------------------- scenario side (subprocess)
 
 
@@ -315,6 +325,45 @@ def scenario_jobs(ctx, state, out: dict) -> None:
     _wait(ctx, lambda: state.job_compare is not None)
     out["reference_done"] = state.job.snapshot()[0].fraction == 1.0
     out["reference_rmse"] = state.job_compare["rmse"]
+
+
+def scenario_smoke(ctx, state, out: dict) -> None:
+    """Drive every panel once (spot light, lecture attenuation, tessellation, toggles)."""
+    ctx.yield_(3)
+    ctx.window_focus("//Lights")
+    ctx.yield_(3)  # the tab comes to the front
+    ctx.set_ref("//Lights/light0/###node")  # combo_click splits its ref at the first '/'
+    ctx.combo_click("kind/spot")
+    ctx.yield_(2)
+    ctx.combo_click("attenuation/lecture")
+    ctx.yield_(2)
+    ctx.item_input_value("c1", 2.0)
+    ctx.yield_(3)
+    light = state.scene.lights[0]
+    out["light"] = [light.kind, light.attenuation, light.c1]
+    _probe_at(ctx, state, (state.viewport_size[0] // 2, int(state.viewport_size[1] * 0.85)))
+    out["spot_gpu"], out["spot_reference"] = state.probe.gpu.tolist(), \
+        state.probe.reference.tolist()
+    keys = {i: g.key for i, g in state.gl.renderer._gpu.items()}
+    ctx.window_focus("//Objects")
+    ctx.yield_(3)
+    ctx.set_ref("//Objects")
+    ctx.item_open("object0/###obj")
+    ctx.item_input_value("object0/###obj/tessellation (segments)", 4)
+    ctx.yield_(3)
+    out["segments"] = state.scene.objects[0].segments
+    out["uploaded_keys_changed"] = [i for i, g in state.gl.renderer._gpu.items()
+                                    if keys.get(i) != g.key]
+    toggles = {"compare": "c", "diff_enabled": "d", "show_wireframe": "w",
+               "show_normals": "n", "presenter": "f", "show_help": "h"}
+    for key in toggles.values():
+        ctx.key_press(imgui_key(key))
+        ctx.yield_(2)
+    out["toggles"] = {name: getattr(state, name) for name in toggles}
+    for key in toggles.values():
+        ctx.key_press(imgui_key(key))
+        ctx.yield_(2)
+    out["after_toggles"] = {name: getattr(state, name) for name in toggles}
 
 
 OUT_DIR = "."
