@@ -181,7 +181,9 @@ def uniform_patches(scene: Scene, count: int) -> PatchSet:
         raise ShadeLabError("objects: the scene has no surfaces to mesh into patches")
     total = sum(_surface_area(s) for s in surfaces)
     # Find the patch size h whose meshing comes closest to the target count (bisection on log h)
-    lo, hi = math.sqrt(total / count) / 8.0, math.sqrt(total) * 2.0
+    # (capped near the mean patch size, so that mesh objects, which keep one patch per
+    # triangle at least, do not leave the quads a single patch each)
+    lo, hi = math.sqrt(total / count) / 8.0, math.sqrt(total / count) * 1.5
     for _ in range(40):
         mid = math.sqrt(lo * hi)
         if _count_for(surfaces, mid) > count:
