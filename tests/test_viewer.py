@@ -381,3 +381,25 @@ def test_a_picklable_job_runs_in_the_worker_process_and_cancels():
     finally:
         runner.shutdown()
     assert runner.worker.process is None
+
+
+def test_open_a_mesh_file_adds_it_and_a_broken_one_keeps_the_scene(tmp_path):
+    state = AppState.from_scene(load_preset("cornell"), "cornell")
+    count = len(state.scene.objects)
+    good = tmp_path / "tetra.obj"
+    good.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+                    "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n")
+    assert state.open_file(str(good)) and len(state.scene.objects) == count + 1
+    added = state.scene.objects[-1]
+    assert added.shape == "mesh" and added.material in state.scene.materials
+    from app.geometry.mesh import scene_bounds, scene_meshes
+
+    lo, hi = scene_bounds([scene_meshes(state.scene)[-1]])
+    assert np.max(hi - lo) == pytest.approx(0.3 * 800.0, rel=1e-6)  # fitted to the view
+    assert state.history.can_undo()
+    broken = tmp_path / "broken.obj"
+    broken.write_text("v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n")  # one zero-area triangle
+    assert not state.open_file(str(broken))
+    assert "broken.obj" in state.error and len(state.scene.objects) == count + 1
+    assert not state.open_file(str(tmp_path / "missing.ply"))
+    assert "not found" in state.error

@@ -109,7 +109,7 @@ def draw_file_panel(state: AppState) -> bool:
         imgui.end_combo()
     _, state.open_path = imgui.input_text("File", state.open_path)
     if imgui.button("Open file"):
-        state.open_preset(state.open_path)
+        state.open_file(state.open_path)  # a preset replaces the scene; a mesh is added
     imgui.same_line()
     if imgui.button("Save as"):
         state.save_as(state.open_path)

@@ -213,6 +213,42 @@ class AppState:
             self.replace_scene(scene)
             self.status = "redo"
 
+    def open_file(self, path: str) -> bool:
+        """A preset (.toml or a name) replaces the scene; a mesh file is added to it."""
+        from app.geometry.mesh import MESH_SUFFIXES
+
+        if Path(path).suffix.lower() in MESH_SUFFIXES:
+            return self.add_mesh(path)
+        return self.open_preset(path)
+
+    def add_mesh(self, path: str) -> bool:
+        """Add a mesh file as an object, fitted in front of the camera; errors keep the scene."""
+        import numpy as np
+
+        from app.geometry.mesh import load_mesh_file
+        from app.scene.model import Material, Object
+
+        key = f"objects.{len(self.scene.objects)}.path"
+        try:
+            mesh = load_mesh_file(str(Path(path).resolve()), ".", key)
+        except ShadeLabError as exc:
+            self.error = str(exc)
+            return False
+        cam = self.scene.camera
+        span = float(np.linalg.norm(np.subtract(cam.target, cam.eye)))
+        lo, hi = np.asarray(mesh.bounds, dtype=np.float64)
+        scale = 0.3 * span / max(float(np.max(hi - lo)), 1e-12)
+        offset = np.asarray(cam.target, dtype=np.float64) - scale * (lo + hi) / 2.0
+        if "mesh" not in self.scene.materials:
+            self.scene.materials["mesh"] = Material(ka=0.1, kd=0.7, ks=0.3, n=20.0)
+        self.scene.objects.append(Object(
+            shape="mesh", name=Path(path).stem, material="mesh", path=str(Path(path).resolve()),
+            scale=(scale,) * 3, translate=tuple(float(c) for c in offset), normals="angle"))
+        self.mark_edited()
+        self.commit_edit()
+        self.error, self.status = "", f"added mesh {path}"
+        return True
+
     def open_preset(self, name_or_path: str) -> bool:
         """Load a preset; on bad input show the error and keep the current scene."""
         try:
