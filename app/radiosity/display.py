@@ -19,7 +19,7 @@ Mesh = tuple[np.ndarray, np.ndarray, np.ndarray]  # vertices (V,3), faces (F,3),
 
 def display_meshes(patches: PatchSet, radiance: np.ndarray, conforming: bool = True) -> list[Mesh]:
     """One (vertices, faces, vertex_radiance) per surface; ``radiance`` is (N, 3) per patch."""
-    meshes = []
+    meshes, owners = [], []
     for index, surface in enumerate(patches.surfaces):
         members = np.flatnonzero(patches.surface == index)
         if len(members) == 0:
@@ -28,9 +28,39 @@ def display_meshes(patches: PatchSet, radiance: np.ndarray, conforming: bool = T
             meshes.append(_quad_display(patches, index, members, radiance, conforming))
         else:
             meshes.append(_mesh_display(patches, index, members, radiance))
+        owners.append(index)
     if not patches.surfaces:  # a bare patch set: one flat-shaded quad per patch
         meshes.append(_bare_display(patches, radiance))
+    elif conforming:
+        _share_coplanar_vertices(patches, owners, meshes)
     return meshes
+
+
+def _share_coplanar_vertices(patches: PatchSet, owners: list[int], meshes: list[Mesh]) -> None:
+    """Average the values of vertices that coplanar quads of one material share (a floor or
+    ceiling modelled in pieces), so no seam shows where the pieces meet. In place."""
+    keys, where = [], []
+    span = float(np.ptp(patches.polygons.reshape(-1, 3), axis=0).max()) or 1.0
+    for m, index in enumerate(owners):
+        surface = patches.surfaces[index]
+        if surface.kind != "quad":
+            continue
+        normal = patches.normals[np.flatnonzero(patches.surface == index)[0]]
+        vertices = meshes[m][0]
+        q = np.round(vertices / (span * 1e-7)).astype(np.int64)
+        n = np.round(normal * 1e4).astype(np.int64)
+        for v in range(len(vertices)):
+            keys.append((surface.material, *n, *q[v]))
+            where.append((m, v))
+    groups: dict[tuple, list] = {}
+    for key, item in zip(keys, where, strict=True):
+        groups.setdefault(key, []).append(item)
+    for items in groups.values():
+        if len({m for m, _ in items}) < 2:
+            continue
+        mean = np.mean([meshes[m][2][v] for m, v in items], axis=0)
+        for m, v in items:
+            meshes[m][2][v] = mean
 
 
 def _quad_display(patches: PatchSet, index: int, members: np.ndarray, radiance: np.ndarray,
