@@ -2,6 +2,7 @@
 
 import sys
 
-from app.cli import main
+if __name__ == "__main__":  # spawned worker processes import this module without running it
+    from app.cli import main
 
-sys.exit(main())
+    sys.exit(main())

@@ -53,8 +53,8 @@ def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     parser = build_parser()
     commands = set(parser._subparsers._group_actions[0].choices)  # noqa: SLF001
-    if not argv or (argv[0] not in commands and not argv[0].startswith("-")):
-        argv = ["view", *argv]  # 'shadelab [PRESET]' opens the viewer
+    if not argv or (argv[0] not in commands and argv[0] not in ("-h", "--help")):
+        argv = ["view", *argv]  # 'shadelab [PRESET] [view options]' opens the viewer
     try:
         args = parser.parse_args(argv)
         return int(args.run(args) or 0)

@@ -18,9 +18,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from app.geometry.mesh import MeshData, scene_meshes
+from app.raytrace import BACKENDS  # noqa: F401  (re-exported: accel.BACKENDS)
 from app.scene.model import Scene
 
-BACKENDS = ("auto", "embree", "bvh")
 T_INF = 1e30  # "no hit" distance, world units
 
 

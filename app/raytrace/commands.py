@@ -9,7 +9,7 @@ import numpy as np
 
 from app.errors import ShadeLabError
 from app.imageio import add_scene_arguments, check_outputs, parse_size, save_outputs
-from app.raytrace.accel import BACKENDS
+from app.raytrace import BACKENDS
 from app.scene.preset import load_preset
 
 MAX_DEPTH = 64
