@@ -34,8 +34,10 @@ def test01_meshes_have_the_documented_layout(leak_solution):
         assert np.all(np.isfinite(radiance)) and radiance.min() >= 0.0
 
 
-def test02_interior_vertices_average_their_patches():
-    """A 2 x 2 grid on one quad: the centre vertex is the area-weighted mean of the four."""
+def test02_interior_vertices_average_their_patches(monkeypatch):
+    """Without the mean-matching sweeps, an interior vertex is the area-weighted mean of the
+    patches around it (the lecture's rule)."""
+    monkeypatch.setattr("app.radiosity.display.RECONSTRUCTION_SWEEPS", 0)
     scene = load_preset("radiosity-box")
     patches = uniform_patches(scene, 40)
     floor = np.flatnonzero(patches.surface == 0)
@@ -48,6 +50,28 @@ def test02_interior_vertices_average_their_patches():
     expected = (radiance[touching] * patches.areas[touching, None]).sum(0) \
         / patches.areas[touching].sum()
     np.testing.assert_allclose(values[centre], expected, rtol=1e-12)
+
+
+def test02b_reconstruction_keeps_patch_means(leak_solution, monkeypatch):
+    """The sweeps bring each patch's corner mean closer to its own radiance: the summed
+    mismatch falls by a third against plain averaging in the leak room (measured 0.64x;
+    bound 0.75x); in the Cornell image the mean's bias goes from -4 % to -1.2 %."""
+    from app.radiosity import display
+
+    p = leak_solution.patches
+    radiance = leak_solution.radiance
+
+    def mismatch():
+        total = 0.0
+        for index, (vertices, _, values) in enumerate(display_meshes(p, radiance)):
+            for k in np.flatnonzero(p.surface == index):
+                ids = [int(np.argmin(np.linalg.norm(vertices - c, axis=1))) for c in p.polygons[k]]
+                total += p.areas[k] * np.abs(values[ids].mean(axis=0) - radiance[k]).sum()
+        return total
+
+    corrected = mismatch()
+    monkeypatch.setattr(display, "RECONSTRUCTION_SWEEPS", 0)
+    assert corrected < 0.75 * mismatch()
 
 
 def test03_adaptive_mesh_is_crack_free():
