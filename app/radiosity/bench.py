@@ -116,7 +116,7 @@ def run(quick: bool) -> dict:
     scene = load_preset("cornell")
     size = (32, 32) if quick else (64, 64)
     ref_spp = 1024 if quick else 2048
-    counts = (400, 800, 1000) if quick else (400, 600, 800, 1000, 1200, 1600)
+    counts = (200, 300, 400, 600, 800, 1000) if quick else (200, 300, 400, 600, 800, 1000, 1200)
     # Warm up: numba JIT (cached), embree, the GL context is not needed (CPU images)
     radiosity_image(scene, (8, 8), 20)
     render_pathtraced(scene, (4, 4), 1, seed=3)
