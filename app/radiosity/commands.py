@@ -6,8 +6,7 @@ import argparse
 
 from app.imageio import add_scene_arguments, check_outputs, parse_size, save_outputs
 from app.progress import run_to_end
-from app.radiosity.patches import check_count
-from app.radiosity.solvers import SOLVERS
+from app.scene.model import RADIOSITY_SOLVERS as SOLVERS
 from app.scene.preset import load_preset
 
 
@@ -32,6 +31,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run_radiosity(args: argparse.Namespace) -> int:
     size = parse_size(args.size)
     if args.patches is not None:
+        from app.radiosity.patches import check_count  # trimesh: only when the command runs
+
         check_count(args.patches)
     scene = load_preset(args.preset, args.set)
     if getattr(args, "error", None) is not None:

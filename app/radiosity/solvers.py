@@ -23,8 +23,9 @@ import numba
 import numpy as np
 
 from app.errors import ShadeLabError
+from app.scene.model import RADIOSITY_SOLVERS
 
-SOLVERS = ("direct", "jacobi", "gauss-seidel", "progressive")
+SOLVERS = RADIOSITY_SOLVERS  # the preset schema's choices
 DIVERGED = 1e12  # a relative residual above this means the iteration blows up
 # Spectral radius of rho F at or above this is refused: form factors carry ~1e-4 quadrature
 # error in their row sums, so an exactly closed rho = 1 scene measures just below 1.

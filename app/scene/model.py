@@ -26,6 +26,7 @@ ATTENUATION_MODES = ("none", "inverse_square", "lecture")
 NORMALS_MODES = ("flat", "average", "area", "angle", "crease")
 SHAPES = ("sphere", "box", "plane", "quad", "cylinder", "cone", "torus", "capsule", "mesh")
 TRANSPARENCY_MODELS = ("interpolated", "filtered")
+RADIOSITY_SOLVERS = ("direct", "jacobi", "gauss-seidel", "progressive")
 
 
 def spec(default: Any, kind: str, *args: Any, doc: str = "") -> Any:
@@ -166,8 +167,7 @@ class RadiositySettings:
 
     patches: int = spec(400, "int", 1, 1000000, doc="target patch count")
     form_factors: str = spec("raycast", "str", ("hemicube", "raycast", "analytic"), doc="method")
-    solver: str = spec("progressive", "str",
-                       ("direct", "jacobi", "gauss-seidel", "progressive"), doc="solver")
+    solver: str = spec("progressive", "str", RADIOSITY_SOLVERS, doc="solver")
     hemicube_resolution: int = spec(128, "int", 4, 4096, doc="hemicube face resolution")
     iterations: int = spec(200, "int", 1, 1000000, doc="maximum solver iterations")
     tolerance: float = spec(1e-4, "float", 0.0, 1.0, doc="relative residual to stop at")
