@@ -37,17 +37,32 @@ def _random_material(rng: np.random.Generator) -> Material:
                     Os=tuple(rng.uniform(0, 1, 3)), emission=tuple(rng.uniform(0, 0.2, 3)))
 
 
-@pytest.fixture(scope="module", params=[None, 3], ids=["uniform-count", "NUM_LIGHTS=3"])
+_PROGRAMS: dict = {}
+
+
+def _harness(ctx, lights: list[Light] | None, specular: str):
+    """The include compiled as the parity harness: driven by uniforms (``lights`` None), or
+    specialized to ``lights`` exactly as the renderer compiles it (``#define NUM_LIGHTS``,
+    ``LIGHT_CODES``, ``SPECULAR_MODEL``)."""
+    defines = None
+    if lights is not None:
+        codes, model = Renderer.light_signature_of(lights, specular)
+        defines = {"NUM_LIGHTS": len(codes), "LIGHT_CODES": ", ".join(map(str, (*codes, 0))),
+                   "SPECULAR_MODEL": 1 if model == "blinn" else 0}
+    key = repr(defines)
+    if key not in _PROGRAMS:
+        register_includes(ctx)
+        _PROGRAMS[key] = ctx.program(
+            vertex_shader=(SHADERS / "parity.vert").read_text(),
+            fragment_shader=with_defines((SHADERS / "parity.frag").read_text(), defines))
+    target = ctx.simple_framebuffer((N_POINTS, 1), components=4, dtype="f4")
+    return ctx, _PROGRAMS[key], target
+
+
+@pytest.fixture(params=["uniforms", "specialized"])
 def harness(gl_ctx, request):
-    """The include as the parity harness compiles it: with a uniform light count, or
-    specialized to 3 lights as the renderer compiles it (``#define NUM_LIGHTS``)."""
-    register_includes(gl_ctx)
-    defines = {"NUM_LIGHTS": request.param} if request.param else None
-    program = gl_ctx.program(
-        vertex_shader=(SHADERS / "parity.vert").read_text(),
-        fragment_shader=with_defines((SHADERS / "parity.frag").read_text(), defines))
-    target = gl_ctx.simple_framebuffer((N_POINTS, 1), components=4, dtype="f4")
-    return gl_ctx, program, target
+    return lambda lights, specular: _harness(
+        gl_ctx, lights if request.param == "specialized" else None, specular)
 
 
 def _gpu_shade(harness, points, normals, od, eye, material, lights, Ia, specular):
@@ -84,27 +99,43 @@ def test_glsl_matches_numpy(harness, np_rng, specular, kind, attenuation):
         material = _random_material(np_rng)
         lights = [_random_light(np_rng, kind, attenuation) for _ in range(3)]
         Ia = np_rng.uniform(0, 0.5, 3)
-        gpu = _gpu_shade(harness, points, normals, od, eye, material, lights, Ia, specular)
+        gpu = _gpu_shade(harness(lights, specular), points, normals, od, eye, material, lights,
+                         Ia, specular)
         ref = shade(points.astype("f4").astype(np.float64), normals.astype("f4"), eye, material,
                     lights, Ia, specular, od=od.astype("f4"))
         np.testing.assert_allclose(gpu, ref, rtol=1e-4, atol=1e-5)
 
 
-def test_eight_lights_and_more(gl_ctx, np_rng):
+def test_eight_lights_and_more(harness, np_rng):
     """All MAX_LIGHTS slots are summed (the renderer promises at least 8 at once)."""
-    register_includes(gl_ctx)
-    program = gl_ctx.program(vertex_shader=(SHADERS / "parity.vert").read_text(),
-                             fragment_shader=with_defines((SHADERS / "parity.frag").read_text(),
-                                                          {"NUM_LIGHTS": 16}))
-    harness = (gl_ctx, program, gl_ctx.simple_framebuffer((N_POINTS, 1), components=4, dtype="f4"))
     points = np_rng.uniform(-1, 1, (N_POINTS, 3))
     normals = normalize(np_rng.normal(size=(N_POINTS, 3)))
     od = np.ones((N_POINTS, 3))
     material = Material(ka=0.0, kd=1.0, ks=0.0)
     lights = [_random_light(np_rng, "directional", "none") for _ in range(16)]
-    gpu = _gpu_shade(harness, points, normals, od, np.zeros(3) + 5, material, lights,
+    gpu = _gpu_shade(harness(lights, "phong"), points, normals, od, np.zeros(3) + 5, material, lights,
                      np.zeros(3), "phong")
     ref = shade(points, normals, np.zeros(3) + 5, material, lights, np.zeros(3), od=od)
     fewer = shade(points, normals, np.zeros(3) + 5, material, lights[:8], np.zeros(3), od=od)
     np.testing.assert_allclose(gpu, ref, rtol=1e-4, atol=1e-5)
     assert np.abs(ref - fewer).max() > 0.1  # the last 8 lights really contribute
+
+
+@pytest.mark.parametrize("specular", ["phong", "blinn"])
+def test_mixed_light_kinds_in_one_program(harness, np_rng, specular):
+    """A specialized program folds each light's own kind and attenuation, not the first's."""
+    lights = [_random_light(np_rng, "point", "lecture"), _random_light(np_rng, "spot", "none"),
+              _random_light(np_rng, "directional", "inverse_square"),
+              _random_light(np_rng, "spot", "inverse_square")]
+    for light in lights:
+        light.cone_angle = 80.0  # wide cones: the spots light most points
+    points = np_rng.uniform(-1, 1, (N_POINTS, 3))
+    normals = normalize(np_rng.normal(size=(N_POINTS, 3)))
+    od = np_rng.uniform(0, 1, (N_POINTS, 3))
+    material = _random_material(np_rng)
+    eye = np.array([0.5, 2.0, 4.0])
+    gpu = _gpu_shade(harness(lights, specular), points, normals, od, eye, material, lights,
+                     np.full(3, 0.1), specular)
+    ref = shade(points.astype("f4").astype(np.float64), normals.astype("f4"), eye, material,
+                lights, np.full(3, 0.1), specular, od=od.astype("f4"))
+    np.testing.assert_allclose(gpu, ref, rtol=1e-4, atol=1e-5)

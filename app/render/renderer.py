@@ -80,33 +80,47 @@ class Renderer:
 
     def __init__(self, ctx: moderngl.Context):
         self.ctx = ctx
-        self._variants: dict[int, dict[str, moderngl.Program]] = {}
-        self.light_count = 1
-        self.programs = self.programs_for_lights(1)
+        self._variants: dict[tuple, dict[str, moderngl.Program]] = {}
+        self.light_signature: tuple = ((), "phong")
+        self.programs = self.programs_for_lights([], "phong")
         self.textures = TextureCache(ctx)
         self._gpu: dict[int, GpuMesh] = {}
         self._shadows = None  # app.render.shadows.ShadowVolumes, made on first use
 
-    def programs_for_lights(self, count: int) -> dict[str, moderngl.Program]:
-        """Every shading program compiled for ``count`` lights (cached).
+    @staticmethod
+    def light_signature_of(lights: list[Light], specular: str) -> tuple:
+        """What a program variant is compiled for: each light's kind and attenuation codes."""
+        codes = tuple(3 * LIGHT_KIND_CODES[light.kind] + ATTENUATION_CODES[light.attenuation]
+                      for light in lights[:MAX_LIGHTS])
+        return codes, specular
 
-        Passes that draw fewer lights (the shadow passes draw one at a time) fill the other
-        slots with Ip = 0, which adds exactly nothing.
+    def programs_for_lights(self, lights: list[Light], specular: str) -> dict:
+        """Every shading program compiled for this light configuration (cached).
+
+        Positions, colors and coefficients stay uniforms, so sliders never recompile; adding
+        a light or changing a light's kind or attenuation mode compiles a new variant once.
+        Passes that draw a subset of the lights (the shadow passes) switch the others off with
+        their shadow factor S_i = 0.
         """
-        if count not in self._variants:
+        signature = self.light_signature_of(lights, specular)
+        if signature not in self._variants:
+            codes, model = signature
+            defines = {"NUM_LIGHTS": len(codes),
+                       "LIGHT_CODES": ", ".join(str(c) for c in (*codes, 0)),
+                       "SPECULAR_MODEL": 1 if model == "blinn" else 0}
             names = [*SHADING_PROGRAMS, *TEXTURED_PROGRAMS.values()]
-            self._variants[count] = {name: load_program(self.ctx, name, {"NUM_LIGHTS": count})
-                                     for name in names}
-        return self._variants[count]
+            self._variants[signature] = {name: load_program(self.ctx, name, defines)
+                                         for name in names}
+        return self._variants[signature]
 
-    def use_light_count(self, count: int) -> None:
-        """Make ``self.programs`` the variant for ``count`` lights (once per frame)."""
-        self.light_count = count
-        self.programs = self.programs_for_lights(count)
+    def use_lights(self, lights: list[Light], specular: str) -> None:
+        """Make ``self.programs`` the variant for these lights (once per frame)."""
+        self.light_signature = self.light_signature_of(lights, specular)
+        self.programs = self.programs_for_lights(lights, specular)
 
     def vao(self, gpu: GpuMesh, program_name: str) -> moderngl.VertexArray:
-        """The object's VAO for a program of the current light-count variant (made lazily)."""
-        key = f"{program_name}/{self.light_count}"
+        """The object's VAO for a program of the current light variant (made lazily)."""
+        key = (program_name, self.light_signature)
         vao = gpu.vaos.get(key)
         if vao is None:
             program = self.programs[program_name]
@@ -182,7 +196,7 @@ class Renderer:
         settings = scene.render
         gpu_meshes = self.sync(scene)
         lights = scene.active_lights()[:MAX_LIGHTS]
-        self.use_light_count(len(lights))
+        self.use_lights(lights, specular)
         painter = settings.visibility == "painter"
         shadowed = settings.shadows == "volumes" and bool(lights) and not painter
         # Shadow volumes reach infinity (w = 0): the whole frame then uses an infinite far plane.
@@ -206,7 +220,7 @@ class Renderer:
         for variant in self.variants(shading):
             self.set_frame_uniforms(variant, scene, view, specular)
             if shadowed:
-                write_light_uniforms(variant, [])
+                write_light_uniforms(variant, lights, shadow=[0.0] * len(lights))
             set_uniform(variant, "u_ambient_on", 1.0)
         self.draw_objects(scene, opaque, shading)
         # --- PASS 3: per light, a stencil count of its shadow volumes (z-fail or z-pass),
@@ -252,7 +266,8 @@ class Renderer:
             self.ctx.depth_func = "<="
             shadows.lit_where_zero()
             for variant in self.variants(shading):
-                write_light_uniforms(variant, [light])
+                write_light_uniforms(variant, lights,
+                                     shadow=[float(j == index) for j in range(len(lights))])
             self.draw_objects(scene, opaque, shading)
         shadows.stencil_off()
         self.ctx.depth_func = "<"

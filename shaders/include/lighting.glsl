@@ -7,13 +7,23 @@
 //   f_att = 1 | 1/d^2 | min(1/(c1 + c2 d + c3 d^2), 1);   R = 2N(N.L) - L;   H = (L+V)/|L+V|
 
 #define MAX_LIGHTS 16
-// The renderer compiles one variant per light count (NUM_LIGHTS): a constant loop unrolls
-// and its array indices become constants, which llvmpipe runs about 2x faster than a loop
-// bounded by a uniform. Without the define the uniform count is used (parity harness).
+// The renderer compiles one variant per light configuration: NUM_LIGHTS, LIGHT_CODES (one
+// kind * 3 + attenuation code per light, then a trailing 0) and SPECULAR_MODEL. The loop then
+// unrolls and every branch on a light's kind or attenuation folds away at compile time; llvmpipe
+// runs masked branches and uniform-bounded loops several times slower. Without the defines the
+// uniforms decide (the parity harness tests both ways).
 #ifdef NUM_LIGHTS
 #define LIGHT_COUNT NUM_LIGHTS
+const int LIGHT_CODE[NUM_LIGHTS + 1] = int[NUM_LIGHTS + 1](LIGHT_CODES);
+#define LIGHT_KIND(i) (LIGHT_CODE[i] / 3)
+#define LIGHT_ATTENUATION(i) (LIGHT_CODE[i] - 3 * (LIGHT_CODE[i] / 3))
 #else
 #define LIGHT_COUNT u_num_lights
+#define LIGHT_KIND(i) u_light_kind[i]
+#define LIGHT_ATTENUATION(i) u_light_attenuation[i]
+#endif
+#ifndef SPECULAR_MODEL
+#define SPECULAR_MODEL u_specular_model
 #endif
 #define LIGHT_POINT 0
 #define LIGHT_DIRECTIONAL 1
@@ -87,18 +97,18 @@ float spot_factor(vec3 to_light, vec3 axis, float cos_cone, float exponent) {
 // One light's diffuse + specular contribution at a point (S_i included).
 vec3 shade_light(int i, vec3 position, vec3 n, vec3 to_eye, vec3 od) {
     // Branch-free where it is cheap: llvmpipe runs divergent branches under masks.
-    int kind = u_light_kind[i];
+    int kind = LIGHT_KIND(i);
     vec3 delta = u_light_position[i] - position;
     float distance = length(delta);
     vec3 to_point = distance > SHADING_EPS ? delta / distance : vec3(0.0);
     bool directional = kind == LIGHT_DIRECTIONAL;
     vec3 to_light = directional ? -u_light_direction[i] : to_point;
-    float f_att = directional ? 1.0 : attenuation(distance, u_light_attenuation[i], u_light_c[i]);
+    float f_att = directional ? 1.0 : attenuation(distance, LIGHT_ATTENUATION(i), u_light_c[i]);
     float spot = 1.0;
     if (kind == LIGHT_SPOT)
         spot = spot_factor(to_light, u_light_direction[i], u_light_spot[i].x, u_light_spot[i].y);
     float specular;
-    if (u_specular_model == 1) specular = blinn_phong_specular(n, to_light, to_eye, u_n);
+    if (SPECULAR_MODEL == 1) specular = blinn_phong_specular(n, to_light, to_eye, u_n);
     else specular = phong_specular(n, to_light, to_eye, u_n);
     vec3 scale = u_light_S[i] * f_att * spot * u_light_Ip[i];
     return scale * (u_kd * od * lambert(n, to_light) + u_ks * u_Os * specular);
