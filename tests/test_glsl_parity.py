@@ -113,8 +113,8 @@ def test_eight_lights_and_more(harness, np_rng):
     od = np.ones((N_POINTS, 3))
     material = Material(ka=0.0, kd=1.0, ks=0.0)
     lights = [_random_light(np_rng, "directional", "none") for _ in range(16)]
-    gpu = _gpu_shade(harness(lights, "phong"), points, normals, od, np.zeros(3) + 5, material, lights,
-                     np.zeros(3), "phong")
+    gpu = _gpu_shade(harness(lights, "phong"), points, normals, od, np.zeros(3) + 5, material,
+                     lights, np.zeros(3), "phong")
     ref = shade(points, normals, np.zeros(3) + 5, material, lights, np.zeros(3), od=od)
     fewer = shade(points, normals, np.zeros(3) + 5, material, lights[:8], np.zeros(3), od=od)
     np.testing.assert_allclose(gpu, ref, rtol=1e-4, atol=1e-5)
