@@ -24,6 +24,7 @@ from app.ui import overlays, panels
 from app.ui.offline import draw_offline_panel
 from app.ui.probe import probe
 from app.ui.state import AUTOSAVE_INTERVAL, COMPARE_LABELS, COMPARE_VIEWS, AppState, save_session
+from app.ui.studies_panel import draw_gallery_panel, draw_studies_panel
 
 ORBIT_SPEED = 0.008        # radians per pixel dragged
 ZOOM_STEP = 0.9            # eye-target distance factor per wheel notch
@@ -46,7 +47,9 @@ class ViewerOptions:
     autosave: bool = True
     show_radiosity: bool = False          # once a radiosity job ends, show its solution
     ray_tree: tuple[int, int] | None = None  # once a Whitted job ends, trace this pixel's tree
-    focus: str = ""                       # dock window brought to front at start
+    focus: str = ""                       # dock windows brought to front at start (a,b,...)
+    study: str = ""                       # study run (quick) at start; --frames counts after it
+    gallery: str = ""                     # failure-gallery case selected and opened at start
     test_function: Callable | None = None  # immapp.testing test body (GUI tests)
 
 
@@ -201,6 +204,7 @@ class Viewer:
     redraw_flags: list = field(default_factory=list)
     cpu_times: list = field(default_factory=list)
     _job_followed_up: bool = False
+    _study_done_at: int = 0            # frame the --study run ended
 
     # ------------------------------------------------------------ GL lifetime
     def post_init(self) -> None:
@@ -212,16 +216,34 @@ class Viewer:
         if self.options.probe is not None:
             self.state.probe_pixel, self.state.probe_requested = self.options.probe, True
         if self.options.focus:
-            for window in hello_imgui.get_runner_params().docking_params.dockable_windows:
-                if window.label.lower().startswith(self.options.focus.lower()):
-                    window.focus_window_at_next_frame = True
+            focus_windows(hello_imgui.get_runner_params().docking_params.dockable_windows,
+                          self.options.focus)
+        if self.options.gallery:
+            self._open_gallery_case(self.options.gallery)
+        if self.options.study:
+            from app.ui.studies_panel import start_study
+
+            start_study(self.state, self.options.study)
         if self.options.job:
             from app.ui.offline import start_job_by_label
 
             start_job_by_label(self.state, self.options.job)
 
+    def _open_gallery_case(self, name: str) -> None:
+        from app.studies.gallery import GALLERY
+        from app.ui.studies import open_case
+
+        names = [case.name for case in GALLERY]
+        if name not in names:
+            self.state.error = f"--gallery '{name}': expected one of {', '.join(names)}"
+            return
+        self.state.gallery_index = names.index(name)
+        open_case(self.state, GALLERY[self.state.gallery_index])
+
     def before_exit(self) -> None:
         self.state.job.shutdown()
+        if self.state.study is not None:
+            self.state.study.shutdown()
         if self.options.autosave:
             self.autosave(force=True)
         if self.options.bench_json:
@@ -514,6 +536,14 @@ class Viewer:
             self.force_interactive = state.frame >= 2 * third
         waiting = self.options.job and (state.job.running or not state.job.started
                                         or state.job_version != state.job.version)
+        if state.study is not None:
+            state.study.poll()  # also while the Studies tab is hidden
+            if self.options.study and not self._study_done_at and not state.study.running:
+                self._study_done_at = state.frame
+            # --frames counts after the study ends (the plot fits its axes over a few frames)
+            waiting = waiting or (self.options.study and (
+                state.study.running
+                or state.frame < self._study_done_at + min(self.options.frames, 10)))
         if self.options.job and not waiting and not self._job_followed_up:
             self._job_followed_up = True
             self.follow_up_job()
@@ -614,6 +644,8 @@ def _docking(viewer: Viewer) -> hello_imgui.DockingParams:
         window("Objects", "LeftSpace", p(panels.draw_objects_panel)),
         window("Viewport", "MainDockSpace", viewer.draw_viewport_window),
         window("Equation & probe", "RightSpace", p(panels.draw_equation_panel)),
+        window("Studies", "RightSpace", p(draw_studies_panel)),
+        window("Failure gallery", "RightSpace", p(draw_gallery_panel)),
         window("Offline render", "RightBottom", p(draw_offline_panel)),
     ]
     for w in params.dockable_windows:
@@ -621,7 +653,24 @@ def _docking(viewer: Viewer) -> hello_imgui.DockingParams:
         # background quad, about 16 ms a frame at 1280x720 on two cores.
         w.imgui_window_flags = imgui.WindowFlags_.no_background
     params.dockable_windows[0].focus_window_at_next_frame = True
+    params.dockable_windows[5].focus_window_at_next_frame = True  # the right column's first tab
     return params
+
+
+def focus_windows(windows, focus: str) -> list[str]:
+    """Bring the named dock windows to the front: ``focus`` is a comma-separated list of label
+    prefixes (or words of a label: 'gallery' finds 'Failure gallery'); one window per dock
+    space. Returns the labels focused."""
+    chosen: dict[str, object] = {}
+    for wanted in (w.strip().lower() for w in focus.split(",") if w.strip()):
+        match = [w for w in windows if w.label.lower().startswith(wanted)] \
+            or [w for w in windows if wanted in w.label.lower()]
+        if match:
+            chosen[match[0].dock_space_name] = match[0]
+    for window in windows:
+        if window.dock_space_name in chosen:
+            window.focus_window_at_next_frame = window is chosen[window.dock_space_name]
+    return [w.label for w in chosen.values()]
 
 
 def _scene_panel(state: AppState) -> bool:

@@ -34,8 +34,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="with --job radiosity: draw the solution in the viewport when done")
     p.add_argument("--ray-tree", metavar="X,Y",
                    help="with --job whitted: draw the ray tree of this pixel of its image")
-    p.add_argument("--focus", metavar="PANEL", help="bring this panel's tab to the front "
-                   "(Scene, Lights, Materials, Objects)")
+    p.add_argument("--focus", metavar="PANEL[,PANEL]", help="bring these panels' tabs to the "
+                   "front (Scene, Lights, Materials, Objects, Equation, Studies, Gallery, ...)")
+    p.add_argument("--study", metavar="NAME", help="run this study (quick) in the Studies panel "
+                   "at start (shading, raytrace, radiosity, shadows); --frames counts after it")
+    p.add_argument("--gallery", metavar="CASE", help="select this failure-gallery case and open "
+                   "it in the viewer at start (e.g. gouraud-highlight)")
     p.add_argument("--presenter", action="store_true", help="large fonts for a projector")
     p.add_argument("--wireframe", action="store_true", help="show the wireframe")
     p.add_argument("--normals", action="store_true", help="show normal glyphs")
@@ -53,6 +57,23 @@ def _pixel(text: str, flag: str) -> tuple[int, int]:
     if x < 0 or y < 0:
         raise ShadeLabError(f"{flag} '{text}': expected non-negative pixel coordinates")
     return x, y
+
+
+def _check_study_and_case(args: argparse.Namespace) -> None:
+    """--study and --gallery name something that exists (one-line error otherwise)."""
+    if args.study:
+        from app.studies import STUDIES
+
+        names = [name for name, _ in STUDIES]
+        if args.study not in names:
+            raise ShadeLabError(f"--study '{args.study}': expected one of {', '.join(names)}")
+    if args.gallery:
+        from app.studies.gallery import GALLERY
+
+        names = [case.name for case in GALLERY]
+        if args.gallery not in names:
+            raise ShadeLabError(f"--gallery '{args.gallery}': expected one of "
+                                f"{', '.join(names)}")
 
 
 def load_scene(args: argparse.Namespace):
@@ -81,6 +102,7 @@ def run_view(args: argparse.Namespace) -> int:
     ray_tree = _pixel(args.ray_tree, "--ray-tree") if args.ray_tree else None
     if args.frames < 0:
         raise ShadeLabError(f"--frames {args.frames}: expected a count >= 0")
+    _check_study_and_case(args)
     scene, source, restored = load_scene(args)
     from app.geometry.mesh import scene_meshes
 
@@ -98,5 +120,6 @@ def run_view(args: argparse.Namespace) -> int:
                             window_size=window, probe=probe, job=args.job or "",
                             bench_json=args.bench_json or "", autosave=not args.no_autosave,
                             show_radiosity=args.show_radiosity, ray_tree=ray_tree,
-                            focus=args.focus or "")
+                            focus=args.focus or "", study=args.study or "",
+                            gallery=args.gallery or "")
     return run_viewer(state, options)

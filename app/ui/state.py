@@ -160,6 +160,13 @@ class AppState:
     radiosity_soup: Any = None        # (3F, 6) float32 solved display triangles (radiance)
     show_radiosity: bool = False      # draw the radiosity solution instead of the raster
     overlay_version: int = 0          # bumped when the ray tree or radiosity solution changes
+    # Studies and failure gallery panels (app.ui.studies_panel)
+    study: Any = None                 # app.ui.studies.StudyRun, made on first use
+    study_index: int = 0              # into app.studies.STUDIES
+    study_chart: int = 0              # 0: the main chart; i: the result's i-th extra table
+    study_budget: float = 0.01        # auto quality's error budget (relative MSE)
+    gallery_index: int = -1           # selected case of app.studies.gallery.GALLERY
+    gallery_opened: str = ""          # name of the last case opened in the viewer
 
     @classmethod
     def from_scene(cls, scene: Scene, source: str, **kwargs) -> "AppState":
