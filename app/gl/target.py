@@ -45,6 +45,7 @@ class RenderTarget:
     def clear(self, color=(0.0, 0.0, 0.0), stencil: int = 0) -> None:
         """Clear color, depth and stencil (``fbo.clear`` alone never clears stencil)."""
         GL = _gl()
+        _ = self.ctx.error  # a stale moderngl error would be blamed on PyOpenGL's next call
         self.fbo.use()
         self.fbo.depth_mask = True
         self.fbo.color_mask = (True, True, True, True)
@@ -70,6 +71,8 @@ class RenderTarget:
 
     def release(self) -> None:
         GL = _gl()
+        # moderngl re-binds "the previous framebuffer" after some calls: never leave it ours.
+        self.ctx.fbo.use()
         self.fbo.release()
         self.color.release()
         GL.glDeleteFramebuffers(1, [self._framebuffer])
