@@ -164,6 +164,7 @@ class AppState:
     study: Any = None                 # app.ui.studies.StudyRun, made on first use
     study_index: int = 0              # into app.studies.STUDIES
     study_chart: int = 0              # 0: the main chart; i: the result's i-th extra table
+    study_plotted: int = 0            # points the Studies chart drew last frame
     study_budget: float = 0.01        # auto quality's error budget (relative MSE)
     gallery_index: int = -1           # selected case of app.studies.gallery.GALLERY
     gallery_opened: str = ""          # name of the last case opened in the viewer

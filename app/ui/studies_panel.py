@@ -59,9 +59,11 @@ def _wrapped(text: str, color=None) -> None:
     imgui.pop_text_wrap_pos()
 
 
-def _draw_chart(table, front: bool) -> None:
+def _draw_chart(table, front: bool) -> int:
+    """The table's chart; returns the number of points drawn."""
     if not implot.begin_plot(f"{table.title}##study", imgui.ImVec2(-1, PLOT_HEIGHT)):
-        return
+        return 0
+    drawn = 0
     implot.setup_axes(table.x, table.y, implot.AxisFlags_.auto_fit, implot.AxisFlags_.auto_fit)
     if table.log_x:
         implot.setup_axis_scale(implot.ImAxis_.x1, implot.Scale_.log10)
@@ -75,6 +77,7 @@ def _draw_chart(table, front: bool) -> None:
         spec.marker = implot.Marker_.circle
         spec.marker_size = 3.0
         x, y = np.asarray(xs, np.float64), np.asarray(ys, np.float64)
+        drawn += len(x)
         if table.lines:
             implot.plot_line(name, x, y, spec)
         else:
@@ -97,6 +100,7 @@ def _draw_chart(table, front: bool) -> None:
                                np.array([max(p.error, floor) if table.log_y else p.error
                                          for p in best], np.float64), spec)
     implot.end_plot()
+    return drawn
 
 
 def _draw_rows(table) -> None:
@@ -164,7 +168,7 @@ def draw_studies_panel(state: AppState) -> bool:
                 state.study_chart = i
     state.study_chart = min(state.study_chart, len(tables) - 1)
     table = tables[state.study_chart][1]
-    _draw_chart(table, front=table is result)
+    state.study_plotted = _draw_chart(table, front=table is result)
     if study_front(result):
         _, state.study_budget = imgui.slider_float(
             "error budget", state.study_budget, 1e-5, 1.0, "%.2g", imgui.SliderFlags_.logarithmic)
