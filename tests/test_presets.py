@@ -70,6 +70,8 @@ BAD_PRESETS = {
     "wrong type": (GOOD.replace("kd = 0.5", 'kd = "high"'), "materials.m.kd"),
     "nan": (GOOD.replace("kd = 0.5", "kd = nan"), "not finite"),
     "negative": (GOOD.replace("kd = 0.5", "kd = -0.1"), "expected a number in [0, 1]"),
+    "reflectance above 1": (GOOD.replace("kd = 0.5", "kd = 0.5\nOd = [1.2, 0.5, 0.5]"),
+                            "materials.m.Od': expected three numbers in [0, 1]"),
     "version": (GOOD.replace("schema_version = 1", "schema_version = 7"), "schema_version"),
     "material": (GOOD.replace('material = "m"', 'material = "x"'), "objects.0.material"),
     "missing mesh": (GOOD.replace('shape = "sphere"', 'shape = "mesh"\npath = "no.obj"'),

@@ -33,7 +33,7 @@ def spec(default: Any, kind: str, *args: Any, doc: str = "") -> Any:
     """Declare a dataclass field with a validation spec.
 
     kind is one of ``float`` (min, max), ``int`` (min, max), ``bool``, ``str`` (choices or
-    None), ``rgb`` (three finite floats >= 0), ``vec3`` (three finite floats), ``vec3s``
+    None), ``rgb`` (three finite floats >= 0), ``rgb01`` (a reflectance color in [0, 1]), ``vec3`` (three finite floats), ``vec3s``
     (a list of vec3), ``scale`` (a float or a vec3 of positive floats).
     """
     meta = {"spec": (kind, *args), "doc": doc}
@@ -87,17 +87,17 @@ class Material:
     kd: float = spec(0.7, "float", 0.0, 1.0, doc="diffuse-reflection coefficient")
     ks: float = spec(0.0, "float", 0.0, 1.0, doc="specular-reflection coefficient")
     n: float = spec(10.0, "float", 0.0, 100000.0, doc="specular exponent")
-    Od: Rgb = spec((1.0, 1.0, 1.0), "rgb", doc="diffuse color")
-    Os: Rgb = spec((1.0, 1.0, 1.0), "rgb", doc="specular color")
+    Od: Rgb = spec((1.0, 1.0, 1.0), "rgb01", doc="diffuse color")
+    Os: Rgb = spec((1.0, 1.0, 1.0), "rgb01", doc="specular color")
     kt: float = spec(0.0, "float", 0.0, 1.0, doc="transmission coefficient")
-    Ot: Rgb = spec((1.0, 1.0, 1.0), "rgb", doc="transparency color (filtered model)")
+    Ot: Rgb = spec((1.0, 1.0, 1.0), "rgb01", doc="transparency color (filtered model)")
     transparency: str = spec("interpolated", "str", TRANSPARENCY_MODELS, doc="raster model")
     kr: float = spec(-1.0, "float", -1.0, 1.0, doc="mirror reflection; -1 = use ks")
     ior: float = spec(1.5, "float", 1.0, 5.0, doc="index of refraction")
     emission: Rgb = spec((0.0, 0.0, 0.0), "rgb", doc="emitted radiance (radiosity, path tracing)")
     texture: str = spec("", "str", None, doc="'' | 'checker' | image path: modulates Od")
     texture_scale: float = spec(8.0, "float", 1e-6, INF, doc="texture repeats across [0,1] uv")
-    texture_color2: Rgb = spec((0.1, 0.1, 0.1), "rgb", doc="checker's second color")
+    texture_color2: Rgb = spec((0.1, 0.1, 0.1), "rgb01", doc="checker's second color")
     bump: str = spec("", "str", None, doc="'' | 'bumps' | height-map image path")
     bump_scale: float = spec(1.0, "float", 0.0, 100.0, doc="bump height scale")
 

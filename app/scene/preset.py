@@ -192,6 +192,13 @@ def _check(cls: type, key: str, value: Any, source: str, where: str) -> Any:
         return value
     if kind == "rgb":
         return _vec3(value, source, where, "three numbers >= 0 (linear RGB)", minimum=0.0)
+    if kind == "rgb01":
+        out = _vec3(value, source, where, "three numbers in [0, 1] (a reflectance color)",
+                    minimum=0.0)
+        if max(out) > 1.0:
+            raise ShadeLabError(f"{source}: key '{where}': expected three numbers in [0, 1] "
+                                f"(a reflectance color), got {value!r}")
+        return out
     if kind == "vec3":
         return _vec3(value, source, where, "three finite numbers")
     if kind == "vec3s":

@@ -45,6 +45,8 @@ def _field_schema(spec: tuple) -> dict:
         return {"type": "string", "enum": list(args[0])} if args[0] else {"type": "string"}
     if kind == "rgb":
         return {**vec, "items": {"type": "number", "minimum": 0}}
+    if kind == "rgb01":
+        return {**vec, "items": {"type": "number", "minimum": 0, "maximum": 1}}
     if kind == "vec3":
         return vec
     if kind == "vec3s":
