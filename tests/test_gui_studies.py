@@ -195,6 +195,8 @@ def test_gallery_opens_cases_in_the_viewer(xdisplay, tmp_path):  # noqa: F811
     assert r["flat"] == ["sphere-shading", "flat", 2, ""]   # both --set overrides applied
     assert r["broken"][0] == "sphere-shading" and "nope" in r["broken"][1]  # scene kept
     assert r["frames_drawn"] >= 3
+    # an offline case opens its preset (raytrace.offset=0 applied) and starts its renderer
+    assert r["offline"] == ["fail-shadow-acne", 0.0, "Whitted ray tracer", ""]
 
 
 @pytest.mark.gui
@@ -234,6 +236,13 @@ def scenario_gallery(ctx, state, out: dict) -> None:
     ctx.item_click("Open in viewer")
     _wait(ctx, lambda: bool(state.error), 60)
     out["broken"] = [state.source, state.error]
+    state.error, state.job_size = "", 32
+    state.gallery_index = [c.name for c in GALLERY].index("shadow-acne")
+    ctx.yield_(2)
+    ctx.item_click("Run offline job")
+    _wait(ctx, lambda: state.job.started, 60)
+    out["offline"] = [state.source, state.scene.raytrace.offset, state.job.name, state.error]
+    state.job.cancel(wait=True)
     ctx.yield_(2)
     out["frames_drawn"] = state.frame - frame0
 

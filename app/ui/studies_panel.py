@@ -69,7 +69,7 @@ def _draw_chart(table, front: bool) -> int:
         implot.setup_axis_scale(implot.ImAxis_.x1, implot.Scale_.log10)
     if table.log_y:
         implot.setup_axis_scale(implot.ImAxis_.y1, implot.Scale_.log10)
-    implot.setup_legend(implot.Location_.south_west)
+    implot.setup_legend(implot.Location_.east, implot.LegendFlags_.outside)
     for name, xs, ys, labels in plot_series(table):
         if not xs:
             continue
@@ -78,6 +78,8 @@ def _draw_chart(table, front: bool) -> int:
         spec.marker_size = 3.0
         x, y = np.asarray(xs, np.float64), np.asarray(ys, np.float64)
         drawn += len(x)
+        if name.replace(".", "", 1).isdigit() and table.group:
+            name = f"{table.group} {name}"  # "spp 4" rather than a bare "4"
         if table.lines:
             implot.plot_line(name, x, y, spec)
         else:
@@ -96,7 +98,7 @@ def _draw_chart(table, front: bool) -> int:
             spec = implot.Spec()
             spec.line_color = FRONT_COLOR
             spec.line_weight = 1.0
-            implot.plot_stairs("Pareto front", np.array([p.cost for p in best], np.float64),
+            implot.plot_stairs("Pareto", np.array([p.cost for p in best], np.float64),
                                np.array([max(p.error, floor) if table.log_y else p.error
                                          for p in best], np.float64), spec)
     implot.end_plot()
