@@ -71,8 +71,6 @@ class RenderTarget:
 
     def release(self) -> None:
         GL = _gl()
-        # moderngl re-binds "the previous framebuffer" after some calls: never leave it ours.
-        self.ctx.fbo.use()
         self.fbo.release()
         self.color.release()
         GL.glDeleteFramebuffers(1, [self._framebuffer])
