@@ -33,8 +33,8 @@ def spec(default: Any, kind: str, *args: Any, doc: str = "") -> Any:
     """Declare a dataclass field with a validation spec.
 
     kind is one of ``float`` (min, max), ``int`` (min, max), ``bool``, ``str`` (choices or
-    None), ``rgb`` (three finite floats >= 0), ``rgb01`` (a reflectance color in [0, 1]), ``vec3`` (three finite floats), ``vec3s``
-    (a list of vec3), ``scale`` (a float or a vec3 of positive floats).
+    None), ``rgb`` (three finite floats >= 0), ``rgb01`` (a reflectance color in [0, 1]),
+    ``vec3`` (three finite floats), ``vec3s`` (a list of vec3).
     """
     meta = {"spec": (kind, *args), "doc": doc}
     if isinstance(default, (list, dict)):

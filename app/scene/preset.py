@@ -9,11 +9,11 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
+import tomllib
 from pathlib import Path
 from typing import Any
 
 import tomli_w
-import tomllib
 
 from app.errors import ShadeLabError
 from app.resources import presets_dir
