@@ -43,12 +43,10 @@ _PROGRAMS: dict = {}
 def _harness(ctx, lights: list[Light] | None, specular: str):
     """The include compiled as the parity harness: driven by uniforms (``lights`` None), or
     specialized to ``lights`` exactly as the renderer compiles it (``#define NUM_LIGHTS``,
-    ``LIGHT_CODES``, ``SPECULAR_MODEL``)."""
+    ``LIGHT_KINDS``, ``LIGHT_ATTENUATIONS``, ``SPECULAR_MODEL``)."""
     defines = None
     if lights is not None:
-        codes, model = Renderer.light_signature_of(lights, specular)
-        defines = {"NUM_LIGHTS": len(codes), "LIGHT_CODES": ", ".join(map(str, (*codes, 0))),
-                   "SPECULAR_MODEL": 1 if model == "blinn" else 0}
+        defines = Renderer.light_defines(Renderer.light_signature_of(lights, specular))
     key = repr(defines)
     if key not in _PROGRAMS:
         register_includes(ctx)

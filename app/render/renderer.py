@@ -89,10 +89,20 @@ class Renderer:
 
     @staticmethod
     def light_signature_of(lights: list[Light], specular: str) -> tuple:
-        """What a program variant is compiled for: each light's kind and attenuation codes."""
-        codes = tuple(3 * LIGHT_KIND_CODES[light.kind] + ATTENUATION_CODES[light.attenuation]
+        """What a program variant is compiled for: each light's (kind, attenuation) codes."""
+        codes = tuple((LIGHT_KIND_CODES[light.kind], ATTENUATION_CODES[light.attenuation])
                       for light in lights[:MAX_LIGHTS])
         return codes, specular
+
+    @staticmethod
+    def light_defines(signature: tuple) -> dict[str, object]:
+        """The ``#define``s of ``lighting.glsl`` for a light signature (2 bits per light)."""
+        codes, model = signature
+        kinds = sum(kind << (2 * i) for i, (kind, _) in enumerate(codes))
+        attenuations = sum(att << (2 * i) for i, (_, att) in enumerate(codes))
+        return {"NUM_LIGHTS": len(codes), "LIGHT_KINDS": f"{kinds}u",
+                "LIGHT_ATTENUATIONS": f"{attenuations}u",
+                "SPECULAR_MODEL": 1 if model == "blinn" else 0}
 
     def programs_for_lights(self, lights: list[Light], specular: str) -> dict:
         """Every shading program compiled for this light configuration (cached).
@@ -104,10 +114,7 @@ class Renderer:
         """
         signature = self.light_signature_of(lights, specular)
         if signature not in self._variants:
-            codes, model = signature
-            defines = {"NUM_LIGHTS": len(codes),
-                       "LIGHT_CODES": ", ".join(str(c) for c in (*codes, 0)),
-                       "SPECULAR_MODEL": 1 if model == "blinn" else 0}
+            defines = self.light_defines(signature)
             names = [*SHADING_PROGRAMS, *TEXTURED_PROGRAMS.values()]
             self._variants[signature] = {name: load_program(self.ctx, name, defines)
                                          for name in names}

@@ -7,16 +7,15 @@
 //   f_att = 1 | 1/d^2 | min(1/(c1 + c2 d + c3 d^2), 1);   R = 2N(N.L) - L;   H = (L+V)/|L+V|
 
 #define MAX_LIGHTS 16
-// The renderer compiles one variant per light configuration: NUM_LIGHTS, LIGHT_CODES (one
-// kind * 3 + attenuation code per light, then a trailing 0) and SPECULAR_MODEL. The loop then
-// unrolls and every branch on a light's kind or attenuation folds away at compile time; llvmpipe
-// runs masked branches and uniform-bounded loops several times slower. Without the defines the
-// uniforms decide (the parity harness tests both ways).
+// The renderer compiles one variant per light configuration: NUM_LIGHTS, LIGHT_KINDS and
+// LIGHT_ATTENUATIONS (2 bits per light, light i at bits 2i..2i+1, as uint literals) and
+// SPECULAR_MODEL. The loop then unrolls and every branch on a light's kind or attenuation folds
+// away at compile time; llvmpipe runs masked branches and uniform-bounded loops several times
+// slower. Without the defines the uniforms decide (the parity harness tests both ways).
 #ifdef NUM_LIGHTS
 #define LIGHT_COUNT NUM_LIGHTS
-const int LIGHT_CODE[NUM_LIGHTS + 1] = int[NUM_LIGHTS + 1](LIGHT_CODES);
-#define LIGHT_KIND(i) (LIGHT_CODE[i] / 3)
-#define LIGHT_ATTENUATION(i) (LIGHT_CODE[i] - 3 * (LIGHT_CODE[i] / 3))
+#define LIGHT_KIND(i) int((LIGHT_KINDS >> (2u * uint(i))) & 3u)
+#define LIGHT_ATTENUATION(i) int((LIGHT_ATTENUATIONS >> (2u * uint(i))) & 3u)
 #else
 #define LIGHT_COUNT u_num_lights
 #define LIGHT_KIND(i) u_light_kind[i]
