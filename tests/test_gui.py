@@ -322,7 +322,9 @@ def scenario_jobs(ctx, state, out: dict) -> None:
     ctx.yield_(2)
     ctx.item_click("Start")
     _wait(ctx, lambda: state.job.started and not state.job.running, 2000)
-    _wait(ctx, lambda: state.job_compare is not None)
+    # the UI may have compared a partial image first: wait until the final one is uploaded
+    _wait(ctx, lambda: state.job_compare is not None
+          and state.job_version == state.job.snapshot()[1])
     out["reference_done"] = state.job.snapshot()[0].fraction == 1.0
     out["reference_rmse"] = state.job_compare["rmse"]
 
