@@ -1,4 +1,5 @@
 #version 330
+invariant gl_Position;  // same depth in every pass (ambient, per-light, volumes)
 // Flat shading: the equation once per triangle, at its centroid, with the true face normal.
 #include "lighting"
 

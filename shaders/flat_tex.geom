@@ -1,4 +1,5 @@
 #version 330
+invariant gl_Position;  // same depth in every pass (ambient, per-light, volumes)
 // Flat + texture/bump: the equation once per face at its centroid, with the face normal
 // bumped at the centroid's uv. The result is split as I = A Od + B (the equation is linear
 // in Od), so the fragment modulates A by the texture per pixel: texture detail stays sharp

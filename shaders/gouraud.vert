@@ -1,4 +1,5 @@
 #version 330
+invariant gl_Position;  // same depth in every pass (ambient, per-light, volumes)
 // Gouraud shading: the equation per vertex; the rasterizer interpolates the colors.
 #include "lighting"
 

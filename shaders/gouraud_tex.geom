@@ -1,4 +1,5 @@
 #version 330
+invariant gl_Position;  // same depth in every pass (ambient, per-light, volumes)
 // Gouraud + texture/bump: the equation at each corner, with the corner normal bumped at the
 // corner's uv (the triangle's dP/du, dP/dv), split as I = A Od + B; A and B are interpolated
 // and the fragment applies the texture per pixel. Bumps smaller than a triangle cannot show

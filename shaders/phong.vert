@@ -1,4 +1,5 @@
 #version 330
+invariant gl_Position;  // same depth in every pass (ambient, per-light, volumes)
 // Phong shading: normals interpolated here, renormalized and shaded per fragment.
 uniform mat4 u_clip_from_world;
 

@@ -1,4 +1,5 @@
 #version 330
+invariant gl_Position;  // same depth in every pass (ambient, per-light, volumes)
 // Phong + texture/bump: each triangle's dP/du and dP/dv go to the fragments (constant per
 // triangle), which bump the interpolated normal and texture Od per pixel.
 #include "lighting"

@@ -224,12 +224,16 @@ class Renderer:
         # --- PASS 2: opaque surfaces, ambient + every light in one pass (S_i = 1);
         #     with shadow volumes: ambient + emission only (the lights come in pass 3)
         self.ctx.enable_only(moderngl.DEPTH_TEST)
+        if shadowed:
+            self.use_lights([], specular)  # programs with no light loop: ambient + Le only
         for variant in self.variants(shading):
             self.set_frame_uniforms(variant, scene, view, specular)
-            if shadowed:
-                write_light_uniforms(variant, lights, shadow=[0.0] * len(lights))
             set_uniform(variant, "u_ambient_on", 1.0)
         self.draw_objects(scene, opaque, shading)
+        if shadowed:
+            self.use_lights(lights, specular)
+            for variant in self.variants(shading):
+                self.set_frame_uniforms(variant, scene, view, specular)
         # --- PASS 3: per light, a stencil count of its shadow volumes (z-fail or z-pass),
         #     then that light alone added where the count is 0 (S_i = 1), nowhere else
         if shadowed:
