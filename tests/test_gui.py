@@ -54,14 +54,16 @@ def xdisplay():
         os.close(read_fd)  # only now: Xvfb dies of SIGPIPE if it writes to a closed pipe
 
 
-def run_scenario(name: str, display: str, tmp_path: Path) -> dict:
+def run_scenario(name: str, display: str, tmp_path: Path, script: str = __file__,
+                 timeout: float = SCENARIO_TIMEOUT) -> dict:
+    """Run ``script NAME OUTDIR`` (a scenario under the ImGui Test Engine) on ``display``."""
     env = dict(os.environ, DISPLAY=display, XDG_STATE_HOME=str(tmp_path / "state"),
                PYTHONPATH=str(ROOT))
     for key in ("WAYLAND_DISPLAY", "PYOPENGL_PLATFORM"):
         env.pop(key, None)
-    proc = subprocess.run([sys.executable, str(Path(__file__).resolve()), name, str(tmp_path)],
+    proc = subprocess.run([sys.executable, str(Path(script).resolve()), name, str(tmp_path)],
                           env=env, cwd=str(tmp_path), capture_output=True, text=True,
-                          timeout=SCENARIO_TIMEOUT)
+                          timeout=timeout)
     assert proc.returncode == 0, f"scenario {name} failed:\n{proc.stdout[-4000:]}\n" \
                                  f"{proc.stderr[-4000:]}"
     return json.loads((tmp_path / f"{name}.json").read_text())

@@ -10,12 +10,11 @@ Run one scenario by hand:  xvfb-run -a python3 tests/test_gui_studies.py gallery
 from __future__ import annotations
 
 import json
-import os
 import sys
 from pathlib import Path
 
 import pytest
-from test_gui import _wait, xdisplay  # noqa: F401  (the private Xvfb fixture, frame waits)
+from test_gui import _wait, run_scenario, xdisplay  # noqa: F401  (private Xvfb, helpers)
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENARIO_TIMEOUT = 60  # seconds per scenario process
@@ -173,18 +172,7 @@ def test_view_rejects_an_unknown_study_or_case(monkeypatch, capsys, flag, value,
 
 
 def _run_scenario(name: str, display: str, tmp_path: Path) -> dict:
-    import subprocess
-
-    env = dict(os.environ, DISPLAY=display, XDG_STATE_HOME=str(tmp_path / "state"),
-               PYTHONPATH=str(ROOT))
-    for key in ("WAYLAND_DISPLAY", "PYOPENGL_PLATFORM"):
-        env.pop(key, None)
-    proc = subprocess.run([sys.executable, str(Path(__file__).resolve()), name, str(tmp_path)],
-                          env=env, cwd=str(tmp_path), capture_output=True, text=True,
-                          timeout=SCENARIO_TIMEOUT)
-    assert proc.returncode == 0, f"scenario {name} failed:\n{proc.stdout[-4000:]}\n" \
-                                 f"{proc.stderr[-4000:]}"
-    return json.loads((tmp_path / f"{name}.json").read_text())
+    return run_scenario(name, display, tmp_path, script=__file__, timeout=SCENARIO_TIMEOUT)
 
 
 @pytest.mark.gui
