@@ -38,7 +38,8 @@ class GpuMesh:
     key: tuple
     mesh: MeshData
     vbo: moderngl.Buffer
-    vaos: dict[str, moderngl.VertexArray]
+    vaos: dict[tuple, moderngl.VertexArray]  # keyed by (program name, light signature)
+    bounds: np.ndarray  # (2, 3) min and max corner, world space, computed once at upload
 
     def release(self) -> None:
         for vao in self.vaos.values():
@@ -67,10 +68,15 @@ class View:
 
 
 def make_view(scene: Scene, size: tuple[int, int], meshes: list[MeshData],
-              infinite_far: bool = False) -> View:
-    """The scene camera's view for an image of ``size`` = (width, height) pixels."""
+              infinite_far: bool = False, bounds: np.ndarray | None = None) -> View:
+    """The scene camera's view for an image of ``size`` = (width, height) pixels.
+
+    ``bounds`` (2, 3), when the caller has them, spares scanning every vertex of ``meshes``.
+    """
     aspect = size[0] / size[1]
-    far = math.inf if infinite_far else far_plane(scene.camera, scene_bounds(meshes))
+    if bounds is None:
+        bounds = scene_bounds(meshes)
+    far = math.inf if infinite_far else far_plane(scene.camera, bounds)
     clip_from_world = view_matrix(scene.camera) @ projection_matrix(scene.camera, aspect, far)
     return View(clip_from_world, np.asarray(scene.camera.eye, dtype=np.float64), size)
 
@@ -157,7 +163,8 @@ class Renderer:
 
     def _upload(self, key: tuple, mesh: MeshData) -> GpuMesh:
         vbo = self.ctx.buffer(triangle_soup(mesh).tobytes())
-        return GpuMesh(key, mesh, vbo, {})  # VAOs are made per program variant on first draw
+        bounds = np.stack([mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)])
+        return GpuMesh(key, mesh, vbo, {}, bounds)  # VAOs: per program variant, lazily
 
     # ------------------------------------------------------------ uniforms
     def variants(self, shading: str) -> list[moderngl.Program]:
@@ -207,7 +214,8 @@ class Renderer:
         painter = settings.visibility == "painter"
         shadowed = settings.shadows == "volumes" and bool(lights) and not painter
         # Shadow volumes reach infinity (w = 0): the whole frame then uses an infinite far plane.
-        view = make_view(scene, target.size, [g.mesh for g in gpu_meshes], infinite_far=shadowed)
+        view = make_view(scene, target.size, [g.mesh for g in gpu_meshes], infinite_far=shadowed,
+                         bounds=_union_bounds([g.bounds for g in gpu_meshes]))
         opaque = [g for g in gpu_meshes if not is_transparent(scene.materials[g.mesh.material])]
         clear = [g for g in gpu_meshes if is_transparent(scene.materials[g.mesh.material])]
         # --- PASS 1: clear color, depth and stencil
@@ -324,6 +332,14 @@ class Renderer:
             self._shadows.release()
             self._shadows = None
         self.textures.release()
+
+
+def _union_bounds(boxes: list[np.ndarray]) -> np.ndarray | None:
+    """The box around per-object (2, 3) boxes; None for an empty scene (make_view's default)."""
+    if not boxes:
+        return None
+    stacked = np.stack(boxes)
+    return np.stack([stacked[:, 0].min(axis=0), stacked[:, 1].max(axis=0)])
 
 
 def is_transparent(material: Material) -> bool:
