@@ -72,3 +72,17 @@ def test_no_egl_gives_one_line_with_what_to_install(tmp_path):
     assert out.stderr.count("\n") == 1 and "Traceback" not in out.stderr
     assert "EGL" in out.stderr and "apt-get install libegl1 libgl1-mesa-dri" in out.stderr
     assert not (tmp_path / "x.png").exists()
+
+
+@pytest.mark.gl
+def test_releasing_a_render_target_leaves_no_gl_error(gl_ctx):
+    """Creating a framebuffer after a bound one was released must not raise a GL error
+    (moderngl re-binds the previous framebuffer; the anchor keeps that one alive)."""
+    from app.gl.target import RenderTarget
+
+    _ = gl_ctx.error
+    target = RenderTarget(gl_ctx, (8, 8))
+    target.clear()
+    target.release()
+    gl_ctx.simple_framebuffer((4, 4)).release()
+    assert gl_ctx.error == "GL_NO_ERROR"

@@ -45,6 +45,15 @@ def headless_context() -> moderngl.Context:
     return _HEADLESS
 
 
+def make_current(ctx: moderngl.Context) -> None:
+    """Make ``ctx`` the thread's current context again.
+
+    Creating a standalone context makes it current; after a second one is made (and released),
+    the first must be made current before it is used again.
+    """
+    ctx.__enter__()  # glcontext: make current (the matching __exit__ is never needed here)
+
+
 def attach_to_current() -> moderngl.Context:
     """Wrap the context a window toolkit (GLFW, imgui-bundle) made current."""
     return moderngl.create_context(require=GL_VERSION)

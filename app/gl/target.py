@@ -16,6 +16,29 @@ def _gl():
     return GL
 
 
+def bind_anchor(ctx: moderngl.Context) -> None:
+    """Bind the context's own 1x1 framebuffer, which is never released.
+
+    moderngl re-binds "the framebuffer bound before" after creating a framebuffer; if that one
+    was released, GL reports GL_INVALID_OPERATION (and PyOpenGL raises it later, somewhere
+    else). Binding the anchor before releasing any framebuffer keeps that record valid.
+    """
+    if not isinstance(ctx.extra, dict):
+        ctx.extra = {}
+    anchor = ctx.extra.get("shadelab_anchor_fbo")
+    if anchor is None:
+        anchor = ctx.extra["shadelab_anchor_fbo"] = ctx.simple_framebuffer((1, 1))
+        _ = ctx.error  # creating it may report the stale binding it replaces
+    anchor.use()
+
+
+def release_framebuffer(ctx: moderngl.Context, *objects) -> None:
+    """Release framebuffers (and their attachments) without leaving a dangling binding."""
+    bind_anchor(ctx)
+    for obj in objects:
+        obj.release()
+
+
 class RenderTarget:
     """Color texture (RGBA32F, linear radiance) + DEPTH24_STENCIL8 renderbuffer."""
 
@@ -71,7 +94,6 @@ class RenderTarget:
 
     def release(self) -> None:
         GL = _gl()
-        self.fbo.release()
-        self.color.release()
+        release_framebuffer(self.ctx, self.fbo, self.color)
         GL.glDeleteFramebuffers(1, [self._framebuffer])
         GL.glDeleteRenderbuffers(1, [self._renderbuffer])

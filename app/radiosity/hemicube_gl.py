@@ -16,6 +16,7 @@ import numpy as np
 
 from app.gl.context import headless_context
 from app.gl.programs import load_program
+from app.gl.target import bind_anchor
 from app.radiosity.formfactors import hemicube_delta_factors, receiver_samples
 from app.radiosity.patches import PatchSet
 
@@ -40,12 +41,12 @@ def _view(eye: np.ndarray, forward: np.ndarray, up: np.ndarray) -> np.ndarray:
 
 
 def rebind(ctx: moderngl.Context, previous) -> None:
-    """Bind ``previous`` again (or the default framebuffer if it is gone), so that a later
-    ``ctx.framebuffer(...)`` does not try to restore a released one (GL_INVALID_OPERATION)."""
+    """Bind ``previous`` again (or the context's anchor framebuffer if it is gone), so that a
+    later ``ctx.framebuffer(...)`` does not try to restore a released one."""
     if previous is not None and type(previous.mglo).__name__ != "InvalidObject":
         previous.use()
     else:
-        ctx.detect_framebuffer(0).use()
+        bind_anchor(ctx)
 
 
 def tangent_frame(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -11,9 +11,9 @@ import numpy as np
 
 from app.bench import median_time
 from app.geometry.mesh import scene_meshes
-from app.gl.context import create_headless_context, headless_context
+from app.gl.context import create_headless_context, headless_context, make_current
 from app.gl.programs import load_program, set_uniform
-from app.gl.target import RenderTarget
+from app.gl.target import RenderTarget, release_framebuffer
 from app.render.renderer import Renderer, make_view, triangle_soup
 from app.scene.camera import gl_matrix
 from app.scene.preset import list_presets, load_preset
@@ -23,6 +23,7 @@ SIZE = (800, 600)
 
 def time_to_first_image() -> float:
     """Seconds from a new EGL context to the first cornell image read back."""
+    shared = headless_context()
     start = time.perf_counter()
     ctx = create_headless_context()
     renderer = Renderer(ctx)
@@ -33,6 +34,7 @@ def time_to_first_image() -> float:
     renderer.release()
     target.release()
     ctx.release()
+    make_current(shared)  # the new context was current; give the process's context back
     return elapsed
 
 
@@ -65,8 +67,9 @@ def bare_phong_frame(ctx: moderngl.Context, preset: str):
         ctx.finish()
 
     def release():
-        for res in (vao, vbo, program, fbo):
+        for res in (vao, vbo, program):
             res.release()
+        release_framebuffer(ctx, fbo)
 
     return frame, release
 
