@@ -28,8 +28,8 @@ def pytest_addoption(parser):
 @pytest.fixture(scope="session")
 def gl_ctx():
     """The process's headless EGL context (this is the only place tests get one)."""
-    from app.errors import ShadeLabError
-    from app.gl.context import headless_context
+    from shadelab.errors import ShadeLabError
+    from shadelab.gl.context import headless_context
 
     try:
         ctx = headless_context()

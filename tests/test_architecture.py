@@ -7,9 +7,9 @@ import sys
 
 import pytest
 
-PURE = ["app.scene", "app.scene.preset", "app.scene.camera", "app.shading",
-        "app.shading.reference", "app.geometry.mesh", "app.geometry.normals", "app.progress"]
-OPTIONAL_PURE = ["app.raytrace", "app.radiosity", "app.geometry.silhouette"]
+PURE = ["shadelab.scene", "shadelab.scene.preset", "shadelab.scene.camera", "shadelab.shading",
+        "shadelab.shading.reference", "shadelab.geometry.mesh", "shadelab.geometry.normals", "shadelab.progress"]
+OPTIONAL_PURE = ["shadelab.raytrace", "shadelab.radiosity", "shadelab.geometry.silhouette"]
 FORBIDDEN = ("moderngl", "glfw", "imgui_bundle", "OpenGL")
 
 

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from app.cli import main
-from app.errors import ShadeLabError
-from app.studies.autoquality import FrontPoint, choose_setting, pareto_front
+from shadelab.cli import main
+from shadelab.errors import ShadeLabError
+from shadelab.studies.autoquality import FrontPoint, choose_setting, pareto_front
 
 FRONT = [FrontPoint({"level": k}, cost=20 * 4 ** k, error=0.1 / 3.5 ** k) for k in range(6)]
 
@@ -53,8 +53,8 @@ def test04_bad_budget_is_an_error(budget):
 @pytest.mark.gl
 @pytest.mark.parametrize("shading", ["flat", "gouraud", "phong"])
 def test05_measured_tessellation_front(gl_ctx, shading):
-    from app.studies.autoquality import front_from_rows
-    from app.studies.shading_study import COLUMNS, measure_sphere, study_scene
+    from shadelab.studies.autoquality import front_from_rows
+    from shadelab.studies.shading_study import COLUMNS, measure_sphere, study_scene
 
     rows = measure_sphere(study_scene(), 0, shading, (48, 48), repeats=1)
     records = [dict(zip(COLUMNS, r, strict=True)) for r in rows]
@@ -83,10 +83,10 @@ def test07_render_error_flag_bad_input(tmp_path, capsys, value):
 
 
 def test08_measured_raytrace_front():
-    pytest.importorskip("app.raytrace.whitted")
-    from app.scene.preset import load_preset
-    from app.studies.autoquality import front_from_rows
-    from app.studies.raytrace_study import COLUMNS, measure
+    pytest.importorskip("shadelab.raytrace.whitted")
+    from shadelab.scene.preset import load_preset
+    from shadelab.studies.autoquality import front_from_rows
+    from shadelab.studies.raytrace_study import COLUMNS, measure
 
     rows = measure(load_preset("whitted"), (24, 24), (0, 1, 2, 4), (1, 4), (8, 16))
     records = [dict(zip(COLUMNS, r, strict=True)) for r in rows]
@@ -98,7 +98,7 @@ def test08_measured_raytrace_front():
 
 
 def test09_raytrace_error_flag(tmp_path, capsys):
-    pytest.importorskip("app.raytrace.whitted")
+    pytest.importorskip("shadelab.raytrace.whitted")
     out = tmp_path / "w.png"
     assert main(["raytrace", "whitted", "-o", str(out), "--size", "24x18",
                  "--error", "0.05"]) == 0
@@ -109,9 +109,9 @@ def test09_raytrace_error_flag(tmp_path, capsys):
 
 
 def test10_radiosity_auto_quality():
-    pytest.importorskip("app.radiosity.solution")
-    from app.scene.preset import load_preset
-    from app.studies.radiosity_study import auto_radiosity
+    pytest.importorskip("shadelab.radiosity.solution")
+    from shadelab.scene.preset import load_preset
+    from shadelab.studies.radiosity_study import auto_radiosity
 
     scene = load_preset("radiosity-box")
     patches, resolution, line = auto_radiosity(scene, (32, 32), 0.05, "raycast",
@@ -122,7 +122,7 @@ def test10_radiosity_auto_quality():
 
 @pytest.mark.parametrize("value", ["0", "-2", "inf"])
 def test11_radiosity_error_flag_bad_input(tmp_path, capsys, value):
-    pytest.importorskip("app.radiosity.commands")
+    pytest.importorskip("shadelab.radiosity.commands")
     code = main(["radiosity", "cornell", "-o", str(tmp_path / "r.png"), "--error", value])
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1 and "--error" in err

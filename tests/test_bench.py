@@ -7,7 +7,7 @@ import math
 
 import pytest
 
-from app.cli import main
+from shadelab.cli import main
 
 
 @pytest.mark.gl

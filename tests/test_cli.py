@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from app.cli import main
-from app.scene.preset import list_presets
+from shadelab.cli import main
+from shadelab.scene.preset import list_presets
 
 
 @pytest.mark.gl
@@ -54,10 +54,10 @@ def test_validate_reports_counts(capsys):
 
 
 def test_python_dash_m_app_is_the_same_command():
-    out = subprocess.run([sys.executable, "-m", "app", "validate", "sphere-shading"],
+    out = subprocess.run([sys.executable, "-m", "shadelab", "validate", "sphere-shading"],
                          capture_output=True, text=True)
     assert out.returncode == 0 and "ok sphere-shading" in out.stdout
-    bad = subprocess.run([sys.executable, "-m", "app", "validate", "nope"],
+    bad = subprocess.run([sys.executable, "-m", "shadelab", "validate", "nope"],
                          capture_output=True, text=True)
     assert bad.returncode == 2 and bad.stderr.startswith("shadelab: error: unknown preset")
     assert "Traceback" not in bad.stderr
@@ -65,7 +65,7 @@ def test_python_dash_m_app_is_the_same_command():
 
 def test_no_egl_gives_one_line_with_what_to_install(tmp_path):
     env = {**__import__("os").environ, "SHADELAB_LIBEGL": str(tmp_path / "libEGL-missing.so")}
-    out = subprocess.run([sys.executable, "-m", "app", "render", "cornell", "-o",
+    out = subprocess.run([sys.executable, "-m", "shadelab", "render", "cornell", "-o",
                           str(tmp_path / "x.png"), "--size", "8x8"],
                          capture_output=True, text=True, env=env)
     assert out.returncode == 2
@@ -78,7 +78,7 @@ def test_no_egl_gives_one_line_with_what_to_install(tmp_path):
 def test_releasing_a_render_target_leaves_no_gl_error(gl_ctx):
     """Creating a framebuffer after a bound one was released must not raise a GL error
     (moderngl re-binds the previous framebuffer; the anchor keeps that one alive)."""
-    from app.gl.target import RenderTarget
+    from shadelab.gl.target import RenderTarget
 
     _ = gl_ctx.error
     target = RenderTarget(gl_ctx, (8, 8))

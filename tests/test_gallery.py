@@ -14,9 +14,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from app.cli import main
-from app.studies import metrics
-from app.studies.gallery import GALLERY, available, case_named, load_case
+from shadelab.cli import main
+from shadelab.studies import metrics
+from shadelab.studies.gallery import GALLERY, available, case_named, load_case
 
 SMALL = (64, 48)
 
@@ -30,7 +30,7 @@ def _case_scene(name: str):
 
 
 def _raster(scene, size=SMALL, shading=None):
-    from app.render.offscreen import render_image
+    from shadelab.render.offscreen import render_image
 
     return render_image(scene, size, shading).astype(np.float64)
 
@@ -51,7 +51,7 @@ def test00_table_is_complete():
 @pytest.mark.gl
 def test01_gouraud_misses_the_highlight(gl_ctx):
     scene = _case_scene("gouraud-highlight")
-    from app.shading.reference import shade
+    from shadelab.shading.reference import shade
 
     gouraud, phong = _raster(scene, shading="gouraud"), _raster(scene, shading="phong")
     # The mirror point of the light seen from the eye: (0, 0, z*) on the floor y = 0
@@ -67,7 +67,7 @@ def test01_gouraud_misses_the_highlight(gl_ctx):
 @pytest.mark.gl
 def test02_mach_bands_are_slope_jumps(gl_ctx):
     """Along a row, Gouraud's second difference is spiky (kinks at edges), the exact one smooth."""
-    from app.studies.shading_study import exact_sphere_image
+    from shadelab.studies.shading_study import exact_sphere_image
 
     scene = _case_scene("mach-bands")
     size = (96, 96)
@@ -92,7 +92,7 @@ def test03_flat_shading_is_piecewise_constant(gl_ctx):
 
 
 def _stencil_vs_oracle(scene, method, size=SMALL):
-    from app.studies.shadow_study import mismatch, oracle_masks, stencil_masks
+    from shadelab.studies.shadow_study import mismatch, oracle_masks, stencil_masks
 
     scene.render.shadows = "volumes"
     scene.render.shadow_method = method
@@ -112,12 +112,12 @@ def test04_zpass_fails_with_the_eye_inside(gl_ctx):
 @pytest.mark.gl
 def test05_open_caster(gl_ctx):
     """Open casters get per-triangle volumes: the stencil still matches the shadow rays."""
-    from app.geometry.silhouette import closed_caster
+    from shadelab.geometry.silhouette import closed_caster
 
     scene = _case_scene("non-closed-caster")
     card = scene.objects[1]
     assert card.shape == "quad"
-    from app.geometry.mesh import scene_meshes
+    from shadelab.geometry.mesh import scene_meshes
 
     mesh = scene_meshes(scene)[1]
     assert closed_caster(mesh.vertices, mesh.faces) is None      # really open
@@ -136,7 +136,7 @@ def test06_painter_cycle(gl_ctx):
 
 
 def test07_shadow_acne_without_offset():
-    from app.raytrace.whitted import render_raytraced
+    from shadelab.raytrace.whitted import render_raytraced
 
     scene = _case_scene("shadow-acne")
     size = (48, 36)
@@ -151,7 +151,7 @@ def test07_shadow_acne_without_offset():
 
 
 def test08_total_internal_reflection():
-    from app.raytrace.surface import reflect_refract
+    from shadelab.raytrace.surface import reflect_refract
 
     ior = 1.5
     critical = math.asin(1.0 / ior)                       # 41.81 degrees
@@ -165,7 +165,7 @@ def test08_total_internal_reflection():
     ok = ~tir
     np.testing.assert_allclose(refr[ok, 0], ior * np.sin(angles[ok]), atol=1e-12)  # Snell
     assert np.all(np.isfinite(refr))
-    from app.raytrace.whitted import render_raytraced
+    from shadelab.raytrace.whitted import render_raytraced
 
     image = render_raytraced(_case_scene("total-internal-reflection"), (32, 24))
     assert np.all(np.isfinite(image)) and image.min() >= 0.0
@@ -175,8 +175,8 @@ def test08_total_internal_reflection():
 def test09_hemicube_aliasing(gl_ctx):
     """A patch smaller than a hemicube pixel: at 8 px its form factor jumps between missing
     (-100 %) and +50 % as it slides by sub-pixel steps; at 256 px it stays within 5 %."""
-    pytest.importorskip("app.radiosity.hemicube_gl")
-    gallery = pytest.importorskip("app.radiosity.gallery")
+    pytest.importorskip("shadelab.radiosity.hemicube_gl")
+    gallery = pytest.importorskip("shadelab.radiosity.gallery")
     _case_scene("hemicube-aliasing")
     out = gallery.hemicube_aliasing((8, 256))
     # Known: the GL hemicube leaves GL_INVALID_OPERATION behind (reported to its owner);
@@ -190,7 +190,7 @@ def test09_hemicube_aliasing(gl_ctx):
 def test10_radiosity_light_leak():
     """The floor under a block (exact radiance 0) gets light when its patch runs under the
     block; cutting the floor along the block's base removes the leak."""
-    gallery = pytest.importorskip("app.radiosity.gallery")
+    gallery = pytest.importorskip("shadelab.radiosity.gallery")
     _case_scene("radiosity-light-leak")
     out = gallery.light_leak(40)      # 2 x 2 floor patches, each a quarter under the block
     assert out["unsplit"] > 0.2 * out["lit_floor_mean"]
@@ -200,7 +200,7 @@ def test10_radiosity_light_leak():
 @pytest.mark.gl
 @pytest.mark.parametrize("shading", ["flat", "gouraud", "phong"])
 def test11_degenerate_triangles(gl_ctx, shading):
-    from app.geometry.mesh import scene_meshes
+    from shadelab.geometry.mesh import scene_meshes
 
     scene = _case_scene("degenerate-triangles")
     quad = scene_meshes(scene)[0]
@@ -220,7 +220,7 @@ def test11b_degenerate_mesh_file_is_refused(tmp_path, capsys):
 
 
 def _exact_matches(scene, size=SMALL, tolerance=2e-3):
-    from app.studies.shading_study import exact_sphere_image
+    from shadelab.studies.shading_study import exact_sphere_image
 
     raster = _raster(scene, size, "phong")
     exact, mask = exact_sphere_image(scene, 0, size)

@@ -2,7 +2,7 @@
 
 Seeded random points, normals, materials and lights (every light kind and attenuation mode,
 both specular models) are shaded on the GPU into an N x 1 RGBA32F target and compared with
-app.shading.reference.shade: |error| <= 1e-4 relative (+1e-5 absolute).
+shadelab.shading.reference.shade: |error| <= 1e-4 relative (+1e-5 absolute).
 """
 
 from __future__ import annotations
@@ -13,10 +13,10 @@ import moderngl
 import numpy as np
 import pytest
 
-from app.gl.programs import register_includes, set_uniform, with_defines
-from app.render.renderer import Renderer, write_light_uniforms
-from app.scene.model import Light, Material
-from app.shading.reference import normalize, shade
+from shadelab.gl.programs import register_includes, set_uniform, with_defines
+from shadelab.render.renderer import Renderer, write_light_uniforms
+from shadelab.scene.model import Light, Material
+from shadelab.shading.reference import normalize, shade
 
 pytestmark = pytest.mark.gl
 N_POINTS = 256

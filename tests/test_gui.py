@@ -58,7 +58,7 @@ def run_scenario(name: str, display: str, tmp_path: Path, script: str = __file__
                  timeout: float = SCENARIO_TIMEOUT) -> dict:
     """Run ``script NAME OUTDIR`` (a scenario under the ImGui Test Engine) on ``display``."""
     env = dict(os.environ, DISPLAY=display, XDG_STATE_HOME=str(tmp_path / "state"),
-               PYTHONPATH=str(ROOT))
+               PYTHONPATH=str(ROOT / "app"))
     for key in ("WAYLAND_DISPLAY", "PYOPENGL_PLATFORM"):
         env.pop(key, None)
     proc = subprocess.run([sys.executable, str(Path(script).resolve()), name, str(tmp_path)],
@@ -117,7 +117,7 @@ def test_save_reload_broken_file_and_autosave(xdisplay, tmp_path):
     assert r["saved_kd"] == 0.25 and r["reloaded_kd"] == 0.25
     assert r["title_dirty"].endswith("*") and not r["title_saved"].endswith("*")
     assert "bad.toml" in r["broken_error"] and r["kd_after_broken"] == 0.25
-    from app.scene import load_preset
+    from shadelab.scene import load_preset
 
     autosaved = load_preset(str(tmp_path / "state" / "shadelab" / "autosave.toml"))
     assert autosaved.materials["white"].kd == 0.25
@@ -245,7 +245,7 @@ def scenario_probe_click(ctx, state, out: dict) -> None:
     total = terms.emission + terms.ambient + sum(t.diffuse + t.specular for t in terms.lights)
     out["sum_of_terms"] = total.tolist()
     out["material"] = p.hit.mesh.material
-    from app.ui import overlays
+    from shadelab.ui import overlays
 
     out["arrows"] = len(overlays.probe_arrows(p, 1.0)) // 10  # 5 segments (10 ends) each
     _capture(ctx, str(Path(OUT_DIR) / "probe.png"))
@@ -292,8 +292,8 @@ def scenario_save_reload(ctx, state, out: dict) -> None:
 def scenario_jobs(ctx, state, out: dict) -> None:
     import threading
 
-    from app.progress import Progress
-    from app.ui.jobs import JobKind, available_jobs
+    from shadelab.progress import Progress
+    from shadelab.ui.jobs import JobKind, available_jobs
 
     closed = threading.Event()
 
@@ -395,9 +395,9 @@ def _capture(ctx, path: str) -> None:
 def _main(name: str, out_dir: str) -> int:
     global OUT_DIR
     OUT_DIR = out_dir
-    from app.scene import load_preset
-    from app.ui.app import ViewerOptions, run_viewer
-    from app.ui.state import AppState
+    from shadelab.scene import load_preset
+    from shadelab.ui.app import ViewerOptions, run_viewer
+    from shadelab.ui.state import AppState
 
     scenario = globals()[f"scenario_{name}"]
     out: dict = {}

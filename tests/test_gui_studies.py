@@ -1,6 +1,6 @@
 """The viewer's Studies and Failure gallery panels.
 
-Unit tests of :mod:`app.ui.studies` (no window), then two GUI scenarios on the real viewer
+Unit tests of :mod:`shadelab.ui.studies` (no window), then two GUI scenarios on the real viewer
 under a private Xvfb (the ``xdisplay`` fixture and helpers of tests/test_gui.py), each in its
 own process like the scenarios there.
 
@@ -24,15 +24,15 @@ SCENARIO_TIMEOUT = 60  # seconds per scenario process
 
 
 def _state(preset: str = "cornell"):
-    from app.scene import load_preset
-    from app.ui.state import AppState
+    from shadelab.scene import load_preset
+    from shadelab.ui.state import AppState
 
     return AppState.from_scene(load_preset(preset), preset)
 
 
 def test_load_case_scene_applies_overrides_and_the_raster_shading():
-    from app.studies.gallery import case_named
-    from app.ui.studies import case_shading, load_case_scene, offline_job_of
+    from shadelab.studies.gallery import case_named
+    from shadelab.ui.studies import case_shading, load_case_scene, offline_job_of
 
     scene = load_case_scene(case_named("flat-curved"))
     assert scene.render.shading == "flat" and scene.objects[0].subdivisions == 2
@@ -44,8 +44,8 @@ def test_load_case_scene_applies_overrides_and_the_raster_shading():
 
 
 def test_open_case_replaces_the_scene_like_open_preset():
-    from app.studies.gallery import case_named
-    from app.ui.studies import open_case
+    from shadelab.studies.gallery import case_named
+    from shadelab.ui.studies import open_case
 
     state = _state()
     state.scene.materials["white"].kd = 0.3
@@ -61,8 +61,8 @@ def test_open_case_replaces_the_scene_like_open_preset():
 
 
 def test_a_broken_case_shows_the_error_and_keeps_the_scene():
-    from app.studies.gallery import GalleryCase
-    from app.ui.studies import open_case
+    from shadelab.studies.gallery import GalleryCase
+    from shadelab.ui.studies import open_case
 
     state = _state()
     scene = state.scene
@@ -76,7 +76,7 @@ def test_a_broken_case_shows_the_error_and_keeps_the_scene():
 
 
 def _toy_result(**kwargs):
-    from app.studies.result import StudyResult
+    from shadelab.studies.result import StudyResult
 
     rows = [["a", 1, 1.0, 0.5], ["a", 2, 2.0, 0.1], ["a", 3, 4.0, 0.0],
             ["b", 1, 1.5, 0.05], ["b", 2, 3.0, 0.2], ["b", 3, "n/a", 0.01]]
@@ -86,7 +86,7 @@ def _toy_result(**kwargs):
 
 
 def test_plot_series_groups_rows_and_floors_zero_errors_on_a_log_axis():
-    from app.ui.studies import plot_series
+    from shadelab.ui.studies import plot_series
 
     series = {name: (xs, ys, labels) for name, xs, ys, labels in plot_series(_toy_result())}
     assert list(series) == ["a", "b"]
@@ -97,7 +97,7 @@ def test_plot_series_groups_rows_and_floors_zero_errors_on_a_log_axis():
 
 
 def test_auto_quality_picks_the_cheapest_front_point_within_the_budget():
-    from app.ui.studies import auto_quality_line, study_front
+    from shadelab.ui.studies import auto_quality_line, study_front
 
     result = _toy_result()
     front = study_front(result)
@@ -114,9 +114,9 @@ def test_auto_quality_picks_the_cheapest_front_point_within_the_budget():
 def test_study_run_takes_the_result_or_the_skip_message(monkeypatch):
     import time
 
-    import app.studies
-    from app.ui.jobs import JobRunner
-    from app.ui.studies import StudyRun
+    import shadelab.studies
+    from shadelab.ui.jobs import JobRunner
+    from shadelab.ui.studies import StudyRun
 
     def wait(run):
         deadline = time.perf_counter() + 10
@@ -124,15 +124,15 @@ def test_study_run_takes_the_result_or_the_skip_message(monkeypatch):
             time.sleep(0.01)
         run.poll()
 
-    monkeypatch.setitem(app.studies._STUDY_TABLE, "ghost",
-                        ("app.studies.no_such_study", "run_ghost", "not built"))
+    monkeypatch.setitem(shadelab.studies._STUDY_TABLE, "ghost",
+                        ("shadelab.studies.no_such_study", "run_ghost", "not built"))
     run = StudyRun(runner=JobRunner(use_process=False))
     run.start("ghost")
     wait(run)
     assert run.result is None and run.error == ""
-    assert run.skipped == "ghost: module app.studies.no_such_study is not built yet"
+    assert run.skipped == "ghost: module shadelab.studies.no_such_study is not built yet"
     toy = _toy_result()
-    monkeypatch.setattr(app.studies, "run_study", lambda name, quick: toy)
+    monkeypatch.setattr(shadelab.studies, "run_study", lambda name, quick: toy)
     run.start("toy")
     wait(run)
     assert run.result is toy and run.skipped == "" and run.error == ""
@@ -141,7 +141,7 @@ def test_study_run_takes_the_result_or_the_skip_message(monkeypatch):
 def test_focus_takes_a_list_and_word_matches():
     from imgui_bundle import hello_imgui
 
-    from app.ui.app import focus_windows
+    from shadelab.ui.app import focus_windows
 
     windows = []
     for label, dock in (("Scene", "Left"), ("Lights", "Left"), ("Equation & probe", "Right"),
@@ -160,7 +160,7 @@ def test_focus_takes_a_list_and_word_matches():
     ("--gallery", "nope", "--gallery 'nope': expected one of gouraud-highlight"),
 ])
 def test_view_rejects_an_unknown_study_or_case(monkeypatch, capsys, flag, value, expected):
-    from app.cli import main
+    from shadelab.cli import main
 
     monkeypatch.setenv("DISPLAY", ":987")
     assert main(["view", "--fresh", flag, value]) == 2
@@ -202,7 +202,7 @@ def test_studies_panel_runs_the_quick_shading_study_off_the_ui_thread(xdisplay, 
 
 
 def scenario_gallery(ctx, state, out: dict) -> None:
-    from app.studies.gallery import GALLERY, GalleryCase
+    from shadelab.studies.gallery import GALLERY, GalleryCase
 
     GALLERY.insert(0, GalleryCase("broken-test-case", "cornell", ("materials.nope.kd=1",),
                                "raster:phong", "a case whose override names no material", "t"))
@@ -236,7 +236,7 @@ def scenario_gallery(ctx, state, out: dict) -> None:
 
 
 def scenario_studies(ctx, state, out: dict) -> None:
-    from app.ui.studies import auto_quality_line
+    from shadelab.ui.studies import auto_quality_line
 
     ctx.yield_(3)
     ctx.window_focus("//Studies")
@@ -257,9 +257,9 @@ def scenario_studies(ctx, state, out: dict) -> None:
 
 
 def _main(name: str, out_dir: str) -> int:
-    from app.scene import load_preset
-    from app.ui.app import ViewerOptions, run_viewer
-    from app.ui.state import AppState
+    from shadelab.scene import load_preset
+    from shadelab.ui.app import ViewerOptions, run_viewer
+    from shadelab.ui.state import AppState
 
     scenario = globals()[f"scenario_{name}"]
     out: dict = {}

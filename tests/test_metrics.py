@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app.studies import metrics
+from shadelab.studies import metrics
 
 
 def test01_constant_offset_gives_the_offset():

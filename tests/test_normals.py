@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from app.geometry.normals import corner_normals, face_normals, vertex_normals
+from shadelab.geometry.normals import corner_normals, face_normals, vertex_normals
 
 
 def test_face_normal_right_hand_rule():

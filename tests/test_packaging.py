@@ -24,8 +24,8 @@ def test_wheel_renders_from_any_directory(tmp_path):
     assert build.returncode == 0, build.stderr
     (wheel,) = wheels.glob("shadelab-*.whl")
     names = zipfile.ZipFile(wheel).namelist()
-    assert "app/shaders/include/lighting.glsl" in names
-    assert "app/presets/cornell.toml" in names
+    assert "shadelab/shaders/include/lighting.glsl" in names
+    assert "shadelab/presets/cornell.toml" in names
     site = tmp_path / "site"
     subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--target",
                     str(site), str(wheel)], check=True, capture_output=True)
@@ -33,7 +33,7 @@ def test_wheel_renders_from_any_directory(tmp_path):
     elsewhere.mkdir()
     env = {**os.environ, "PYTHONPATH": str(site)}
     out = subprocess.run([sys.executable, "-c",
-                          "import app, sys; from app.cli import main; print(app.__file__); "
+                          "import shadelab, sys; from shadelab.cli import main; print(shadelab.__file__); "
                           "sys.exit(main(['render', 'cornell', '-o', 'x.png', "
                           "'--size', '32x32']))"],
                          cwd=elsewhere, env=env, capture_output=True, text=True)

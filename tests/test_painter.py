@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app.render.painter import sort_back_to_front
-from app.scene import load_preset
+from shadelab.render.painter import sort_back_to_front
+from shadelab.scene import load_preset
 
 pytestmark = pytest.mark.gl
 
@@ -15,7 +15,7 @@ SIZE = (160, 120)
 
 
 def _render(scene, visibility: str) -> np.ndarray:
-    from app.render.offscreen import render_image
+    from shadelab.render.offscreen import render_image
 
     scene.render.visibility = visibility
     return render_image(scene, SIZE)
@@ -70,7 +70,7 @@ def test_painter_matches_zbuffer_without_cycles(gl_ctx):
 
 
 def test_sort_is_back_to_front():
-    from app.geometry.mesh import scene_meshes
+    from shadelab.geometry.mesh import scene_meshes
 
     scene = load_preset("shadows")
     soup = sort_back_to_front(scene, scene_meshes(scene))

@@ -7,11 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from app.cli import main
-from app.raytrace.pathtrace import iter_pathtrace, render_pathtraced
-from app.scene.camera import primary_rays
-from app.scene.model import Camera, Material, Object, Scene
-from app.scene.preset import load_preset
+from shadelab.cli import main
+from shadelab.raytrace.pathtrace import iter_pathtrace, render_pathtraced
+from shadelab.scene.camera import primary_rays
+from shadelab.scene.model import Camera, Material, Object, Scene
+from shadelab.scene.preset import load_preset
 
 
 def _furnace(rho: tuple, le: tuple) -> Scene:

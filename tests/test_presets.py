@@ -8,9 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from app.cli import main
-from app.errors import ShadeLabError
-from app.scene.preset import (
+from shadelab.cli import main
+from shadelab.errors import ShadeLabError
+from shadelab.scene.preset import (
     list_presets,
     load_preset,
     save_preset,
@@ -116,7 +116,7 @@ def test_good_mesh_file_loads(tmp_path):
 
     trimesh.creation.box().export(tmp_path / "box.ply")
     path = _write(tmp_path, GOOD.replace('shape = "sphere"', 'shape = "mesh"\npath = "box.ply"'))
-    from app.geometry.mesh import scene_meshes
+    from shadelab.geometry.mesh import scene_meshes
 
     meshes = scene_meshes(load_preset(path))
     assert len(meshes[0].faces) == 12
@@ -152,7 +152,7 @@ def test_directory_as_output_is_refused(tmp_path, capsys):
 
 
 def test_existing_output_is_not_truncated_by_the_check(tmp_path):
-    from app.imageio import check_writable
+    from shadelab.imageio import check_writable
 
     keep = tmp_path / "mine.png"
     keep.write_bytes(b"user data")
@@ -167,8 +167,8 @@ def test_error_type_is_one_line():
 
 
 def test_schema_json_is_generated_from_the_model():
-    from app.resources import presets_dir
-    from app.scene.schema import schema_text
+    from shadelab.resources import presets_dir
+    from shadelab.scene.schema import schema_text
 
     committed = (presets_dir() / "schema.json").read_text()
-    assert committed == schema_text(), "run: python -m app.scene.schema > presets/schema.json"
+    assert committed == schema_text(), "run: python -m shadelab.scene.schema > presets/schema.json"

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app.cli import main
+from shadelab.cli import main
 
 
 def _one_line_error(capsys, argv, needle):

@@ -6,12 +6,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app.radiosity.display import crack_report, display_meshes
-from app.radiosity.formfactors import FormFactors
-from app.radiosity.patches import split_leaves, uniform_patches
-from app.radiosity.solution import RadiositySolution, _solve_quick
-from app.scene.model import Object
-from app.scene.preset import load_preset
+from shadelab.radiosity.display import crack_report, display_meshes
+from shadelab.radiosity.formfactors import FormFactors
+from shadelab.radiosity.patches import split_leaves, uniform_patches
+from shadelab.radiosity.solution import RadiositySolution, _solve_quick
+from shadelab.scene.model import Object
+from shadelab.scene.preset import load_preset
 
 
 def _solve(scene, patches):
@@ -37,7 +37,7 @@ def test01_meshes_have_the_documented_layout(leak_solution):
 def test02_interior_vertices_average_their_patches(monkeypatch):
     """Without the mean-matching sweeps, an interior vertex is the area-weighted mean of the
     patches around it (the lecture's rule)."""
-    monkeypatch.setattr("app.radiosity.display.RECONSTRUCTION_SWEEPS", 0)
+    monkeypatch.setattr("shadelab.radiosity.display.RECONSTRUCTION_SWEEPS", 0)
     scene = load_preset("radiosity-box")
     patches = uniform_patches(scene, 40)
     floor = np.flatnonzero(patches.surface == 0)
@@ -56,7 +56,7 @@ def test02b_reconstruction_keeps_patch_means(leak_solution, monkeypatch):
     """The sweeps bring each patch's corner mean closer to its own radiance: the summed
     mismatch falls by a third against plain averaging in the leak room (measured 0.64x;
     bound 0.75x); in the Cornell image the mean's bias goes from -4 % to -1.2 %."""
-    from app.radiosity import display
+    from shadelab.radiosity import display
 
     p = leak_solution.patches
     radiance = leak_solution.radiance
@@ -115,8 +115,8 @@ def test06_gl_image_matches_cpu_and_aligns_with_raster(gl_ctx):
     """Cornell (the open front shows background): the GL program draws the same triangles as
     the CPU rays, equal to 1e-5 relative away from silhouettes (99 % of pixels); the
     coverage equals the raster renderer's pixel for pixel (same camera matrices)."""
-    from app.radiosity.display_gl import render_solution
-    from app.render.offscreen import render_image
+    from shadelab.radiosity.display_gl import render_solution
+    from shadelab.render.offscreen import render_image
 
     scene = load_preset("cornell")
     solution = _solve(scene, uniform_patches(scene, 60))

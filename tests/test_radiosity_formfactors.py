@@ -8,15 +8,15 @@ import math
 import numpy as np
 import pytest
 
-from app.radiosity.formfactors import (
+from shadelab.radiosity.formfactors import (
     FormFactors,
     form_factor_matrix,
     heatmap_data,
     hemicube_delta_factors,
     point_polygon,
 )
-from app.radiosity.patches import from_polygons, uniform_patches
-from app.scene.preset import load_preset
+from shadelab.radiosity.patches import from_polygons, uniform_patches
+from shadelab.scene.preset import load_preset
 
 PARALLEL = 0.19982  # unit squares, aligned, one unit apart (Howell C-11, X = Y = 1)
 PERPENDICULAR = 0.20004  # unit squares sharing an edge at 90 degrees (Howell C-14, W = H = 1)
@@ -142,7 +142,7 @@ def test09_hemicube_closed_box(gl_ctx, box_patches):
 @pytest.mark.gl
 def test10_item_images_of_a_patch(gl_ctx, box_patches):
     """The teaching images: ids on the 5 faces; summing delta factors per id gives the row."""
-    from app.radiosity.hemicube_gl import Hemicube
+    from shadelab.radiosity.hemicube_gl import Hemicube
 
     cube = Hemicube(box_patches, 32)
     images = cube.item_images(3)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app.radiosity import gallery
+from shadelab.radiosity import gallery
 
 
 @pytest.mark.gl

@@ -1,7 +1,7 @@
 """Radiosity against the reference path tracer on the Cornell box (the same scene, units and
 camera: radiance images aligned pixel for pixel).
 
-Error measure (:func:`app.radiosity.bench.image_error`): relative L1 over the pixels away
+Error measure (:func:`shadelab.radiosity.bench.image_error`): relative L1 over the pixels away
 from the light (the light and a one-pixel ring around it are excluded: both methods show its
 Le by definition, and its edge pixels, 100 times brighter than the walls, measure only how
 each samples the light's outline). Radiosity is drawn with 4 x 4 sub-pixels per pixel, the
@@ -20,8 +20,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app.radiosity.bench import emitter_ring_mask, image_error, radiosity_image
-from app.scene.preset import load_preset
+from shadelab.radiosity.bench import emitter_ring_mask, image_error, radiosity_image
+from shadelab.scene.preset import load_preset
 
 BOUND = 0.09
 SIZE = (24, 24)
@@ -29,7 +29,7 @@ SIZE = (24, 24)
 
 @pytest.fixture(scope="module")
 def images():
-    pathtrace = pytest.importorskip("app.raytrace.pathtrace")
+    pathtrace = pytest.importorskip("shadelab.raytrace.pathtrace")
     scene = load_preset("cornell")
     reference = pathtrace.render_pathtraced(scene, SIZE, 512, seed=0)
     solution, image = radiosity_image(scene, SIZE, 400)

@@ -8,11 +8,11 @@ import math
 import numpy as np
 import pytest
 
-from app.errors import ShadeLabError
-from app.radiosity.formfactors import form_factor_matrix
-from app.radiosity.patches import uniform_patches
-from app.radiosity.solvers import SOLVERS, check_solvable, residual, solve
-from app.scene.preset import load_preset
+from shadelab.errors import ShadeLabError
+from shadelab.radiosity.formfactors import form_factor_matrix
+from shadelab.radiosity.patches import uniform_patches
+from shadelab.radiosity.solvers import SOLVERS, check_solvable, residual, solve
+from shadelab.scene.preset import load_preset
 
 
 @pytest.fixture(scope="module")
@@ -82,7 +82,7 @@ def test05_gauss_seidel_beats_jacobi(leak):
 def test06_progressive_ambient_term(leak):
     """The ambient estimate brightens an early display toward the answer, and vanishes as
     the unshot energy does."""
-    from app.radiosity.solvers import solve_progressive
+    from shadelab.radiosity.solvers import solve_progressive
 
     patches, F = leak
     exact = solve("direct", F, patches.rho, patches.E, patches.areas)[0]

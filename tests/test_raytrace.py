@@ -10,15 +10,15 @@ import math
 import numpy as np
 import pytest
 
-from app.cli import main
-from app.raytrace.accel import scene_geometry
-from app.raytrace.surface import TraceContext, reflect_refract
-from app.raytrace.tree import trace_pixel_tree
-from app.raytrace.whitted import render_raytraced, trace_batch
-from app.scene.camera import primary_rays
-from app.scene.model import Camera, Light, Material, Object, RenderSettings, Scene
-from app.scene.preset import load_preset
-from app.shading.conventions import to_srgb8
+from shadelab.cli import main
+from shadelab.raytrace.accel import scene_geometry
+from shadelab.raytrace.surface import TraceContext, reflect_refract
+from shadelab.raytrace.tree import trace_pixel_tree
+from shadelab.raytrace.whitted import render_raytraced, trace_batch
+from shadelab.scene.camera import primary_rays
+from shadelab.scene.model import Camera, Light, Material, Object, RenderSettings, Scene
+from shadelab.scene.preset import load_preset
+from shadelab.shading.conventions import to_srgb8
 
 
 def _scene(objects, materials, lights, eye=(0.0, 0.0, 5.0), target=(0.0, 0.0, 0.0),
@@ -55,7 +55,7 @@ def _edge_mask(scene: Scene, size) -> np.ndarray:
 @pytest.mark.parametrize("preset", ["cornell-spheres", "whitted"])
 def test_depth0_without_shadows_equals_raster_phong(gl_ctx, preset):
     """Depth 0, S_i = 1: every pixel away from silhouettes within 1/255 of the Phong raster."""
-    from app.render.offscreen import render_image
+    from shadelab.render.offscreen import render_image
 
     scene = load_preset(preset)
     size = (48, 40)
@@ -132,7 +132,7 @@ def test_parallel_mirrors_weight_is_kr_to_the_k(k):
 
 
 def _tree_from(ctx, origin, direction, depth):
-    from app.raytrace.tree import _trace
+    from shadelab.raytrace.tree import _trace
 
     return _trace(ctx, "primary", origin, direction, np.ones(3), 0, depth, False)
 
@@ -141,7 +141,7 @@ def test_min_weight_stops_recursion_early_and_reports_depth():
     scene = _mirrors(0.5, emission=1.0)
     scene.raytrace.min_weight = 0.1  # 0.5^4 = 0.0625 < 0.1: three bounces only
     ctx = TraceContext(scene)
-    from app.raytrace.whitted import WavefrontStats
+    from shadelab.raytrace.whitted import WavefrontStats
 
     stats = WavefrontStats()
     out = trace_batch(ctx, np.zeros((1, 3)), np.array([[0.0, 0.0, -1.0]]), 10, False, stats)
@@ -190,7 +190,7 @@ def test_total_internal_reflection_past_the_critical_angle():
     glass = Material(kt=1.0, kr=0.0, ks=0.0, ior=ior)
     scene = _scene([Object(shape="sphere", material="g")], {"g": glass}, [Light()])
     ctx = TraceContext(scene)
-    from app.raytrace.surface import Surface
+    from shadelab.raytrace.surface import Surface
 
     surf = Surface(np.zeros((2, 3)), n, n, np.array([False, False]), np.zeros(2, np.int64))
     _, refl_w, _, refr_w = ctx.secondary(surf, d, fresnel=False)
@@ -207,7 +207,7 @@ def test_fresnel_at_normal_incidence_and_energy_split():
     np.testing.assert_allclose(refr[0], [0.0, 0.0, -1.0], atol=1e-12)
     glass = Material(kt=0.8, kr=0.1, ks=0.0, ior=ior)
     scene = _scene([Object(shape="sphere", material="g")], {"g": glass}, [Light()])
-    from app.raytrace.surface import Surface
+    from shadelab.raytrace.surface import Surface
 
     surf = Surface(np.zeros((1, 3)), n, n, np.array([True]), np.zeros(1, np.int64))
     _, refl_w, _, refr_w = TraceContext(scene).secondary(surf, d, fresnel=True)
@@ -285,7 +285,7 @@ def test_shadow_acne_appears_with_zero_offset():
 
 def test_embree_and_bvh_give_the_same_hits(np_rng):
     pytest.importorskip("embreex")
-    from app.raytrace.accel import BvhAccel, EmbreeAccel
+    from shadelab.raytrace.accel import BvhAccel, EmbreeAccel
 
     scene = load_preset("cornell-spheres")
     geometry = scene_geometry(scene)
@@ -318,7 +318,7 @@ def test_bvh_backend_renders_the_same_image():
 
 
 def test_progress_fractions_and_cancel():
-    from app.raytrace import whitted
+    from shadelab.raytrace import whitted
 
     scene = load_preset("cornell-spheres")
     gen = whitted.iter_raytrace(scene, (64, 1024), depth=1, spp=2)  # 2 tiles per pass

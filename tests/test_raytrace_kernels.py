@@ -1,4 +1,4 @@
-"""The numba kernels are held to the numpy reference (app.shading.reference.shade and the
+"""The numba kernels are held to the numpy reference (shadelab.shading.reference.shade and the
 numpy TraceContext path): 1e-9 relative on random inputs, whole images within 1e-9."""
 
 from __future__ import annotations
@@ -6,13 +6,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app.raytrace import kernels
-from app.raytrace.surface import TraceContext
-from app.raytrace.whitted import render_raytraced, trace_batch
-from app.scene.camera import primary_rays
-from app.scene.model import Light, Material
-from app.scene.preset import load_preset
-from app.shading.reference import normalize, shade
+from shadelab.raytrace import kernels
+from shadelab.raytrace.surface import TraceContext
+from shadelab.raytrace.whitted import render_raytraced, trace_batch
+from shadelab.scene.camera import primary_rays
+from shadelab.scene.model import Light, Material
+from shadelab.scene.preset import load_preset
+from shadelab.shading.reference import normalize, shade
 
 
 def _lights(rng) -> list[Light]:
@@ -65,7 +65,7 @@ def test_whitted_preset_images_agree():
     scene = load_preset("whitted")
     scene.render.specular = "blinn"
     a = render_raytraced(scene, (20, 16), depth=3)
-    from app.raytrace import whitted
+    from shadelab.raytrace import whitted
 
     ctx = TraceContext(scene, local="numpy")
     b = None

@@ -6,13 +6,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app.geometry.mesh import scene_meshes
-from app.render.offscreen import render_image
-from app.scene.camera import primary_rays
-from app.scene.model import Camera, Light, Material, Object, Scene
-from app.scene.preset import list_presets, load_preset
-from app.shading.conventions import to_srgb8
-from app.shading.reference import shade
+from shadelab.geometry.mesh import scene_meshes
+from shadelab.render.offscreen import render_image
+from shadelab.scene.camera import primary_rays
+from shadelab.scene.model import Camera, Light, Material, Object, Scene
+from shadelab.scene.preset import list_presets, load_preset
+from shadelab.shading.conventions import to_srgb8
+from shadelab.shading.reference import shade
 from tests.golden import compare_golden
 
 pytestmark = pytest.mark.gl

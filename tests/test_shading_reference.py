@@ -1,4 +1,4 @@
-"""Closed-form checks of every term of the lecture's equation (app.shading.reference)."""
+"""Closed-form checks of every term of the lecture's equation (shadelab.shading.reference)."""
 
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from app.scene.model import Light, Material
-from app.shading import reference as ref
+from shadelab.scene.model import Light, Material
+from shadelab.shading import reference as ref
 
 UP = np.array([0.0, 0.0, 1.0])
 

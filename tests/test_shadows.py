@@ -16,10 +16,10 @@ import pytest
 import trimesh
 from trimesh.ray.ray_pyembree import RayMeshIntersector
 
-from app.geometry.mesh import scene_bounds, scene_meshes
-from app.scene import load_preset
-from app.scene.camera import primary_rays
-from app.scene.model import Light
+from shadelab.geometry.mesh import scene_bounds, scene_meshes
+from shadelab.scene import load_preset
+from shadelab.scene.camera import primary_rays
+from shadelab.scene.model import Light
 
 SIZE = (160, 120)
 AGREEMENT = 0.995
@@ -73,8 +73,8 @@ def oracle_masks(scene) -> tuple[np.ndarray, np.ndarray]:
 
 
 def gl_masks(scene) -> np.ndarray:
-    from app.render.offscreen import shared_renderer, shared_target
-    from app.render.shadows import shadow_masks
+    from shadelab.render.offscreen import shared_renderer, shared_target
+    from shadelab.render.shadows import shadow_masks
 
     return shadow_masks(shared_renderer(), scene, shared_target(SIZE))
 
@@ -154,7 +154,7 @@ def _flipped_box_obj(path) -> None:
 
 
 def test_inconsistently_wound_caster(gl_ctx, tmp_path):
-    from app.geometry.silhouette import light_homogeneous, shadow_volume
+    from shadelab.geometry.silhouette import light_homogeneous, shadow_volume
 
     _flipped_box_obj(tmp_path / "box.obj")
     scene = load_preset("shadows", ["objects.2.shape=mesh", f"objects.2.path={tmp_path}/box.obj"])
@@ -167,7 +167,7 @@ def test_inconsistently_wound_caster(gl_ctx, tmp_path):
 
 
 def test_shadowed_frame_is_ambient_where_masked_and_unchanged_elsewhere(gl_ctx):
-    from app.render.offscreen import render_image
+    from shadelab.render.offscreen import render_image
 
     scene = load_preset("shadows", ["render.shadows=none"])
     lit = render_image(scene, SIZE)
@@ -185,7 +185,7 @@ def test_shadowed_frame_is_ambient_where_masked_and_unchanged_elsewhere(gl_ctx):
 
 
 def test_cli_teaching_flags_change_the_frame(gl_ctx, tmp_path):
-    from app.cli import main
+    from shadelab.cli import main
 
     out = {}
     for name, flags in (("plain", []), ("volumes", ["--show-volumes"]),
@@ -201,7 +201,7 @@ def test_cli_teaching_flags_change_the_frame(gl_ctx, tmp_path):
 
 
 def test_cli_rejects_unknown_shadow_method(capsys):
-    from app.cli import main
+    from shadelab.cli import main
 
     code = main(["render", "shadows", "-o", "x.png", "--shadow-method", "zmaybe"])
     err = capsys.readouterr().err.strip().splitlines()

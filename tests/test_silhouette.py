@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from app.geometry.silhouette import light_homogeneous, shadow_volume
+from shadelab.geometry.silhouette import light_homogeneous, shadow_volume
 
 
 def _closed(volume, distance=50.0) -> trimesh.Trimesh:

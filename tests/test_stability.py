@@ -13,9 +13,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from app.geometry.normals import corner_normals, face_normals
-from app.scene.model import NORMALS_MODES, Camera, Light, Material, Object, Scene
-from app.shading.reference import shade
+from shadelab.geometry.normals import corner_normals, face_normals
+from shadelab.scene.model import NORMALS_MODES, Camera, Light, Material, Object, Scene
+from shadelab.shading.reference import shade
 
 FAST = settings(max_examples=20, deadline=None,
                 suppress_health_check=[HealthCheck.function_scoped_fixture,
@@ -132,7 +132,7 @@ def _tiny_scene(material: Material, light_list: list[Light], Ia, quad=None) -> S
        kt=st.sampled_from([0.0, 0.5, 1.0]))
 def test04_raster_is_finite_and_non_negative(gl_ctx, material, light_list, Ia, shading,
                                               specular, quad, passes, kt):
-    from app.render.offscreen import render_image
+    from shadelab.render.offscreen import render_image
 
     scene = _tiny_scene(material, light_list, Ia, quad)    # the quad is often degenerate
     scene.render.shadows, scene.render.shadow_method, scene.render.visibility = passes
@@ -170,25 +170,25 @@ def _trace_scene(ball: Material, floor: Material, light_list: list[Light]) -> Sc
     return scene
 
 
-@pytest.mark.skipif(not _has("app.raytrace.whitted"), reason="ray tracer not built yet")
+@pytest.mark.skipif(not _has("shadelab.raytrace.whitted"), reason="ray tracer not built yet")
 @settings(max_examples=15, deadline=None)
 @given(ball=trace_materials(), floor=trace_materials(),
        light_list=st.lists(lights(), min_size=1, max_size=2),
        depth=st.integers(0, 6), fresnel=st.booleans())
 def test05_raytracer_is_finite_and_non_negative(ball, floor, light_list, depth, fresnel):
-    from app.raytrace.whitted import render_raytraced
+    from shadelab.raytrace.whitted import render_raytraced
 
     image = render_raytraced(_trace_scene(ball, floor, light_list), (12, 9), depth, 1,
                              fresnel)
     _assert_clean(np.asarray(image, dtype=np.float64), "raytrace")
 
 
-@pytest.mark.skipif(not _has("app.raytrace.pathtrace"), reason="path tracer not built yet")
+@pytest.mark.skipif(not _has("shadelab.raytrace.pathtrace"), reason="path tracer not built yet")
 @settings(max_examples=10, deadline=None)
 @given(ball=trace_materials(), floor=trace_materials(),
        light_list=st.lists(lights(), min_size=1, max_size=2), seed=st.integers(0, 1000))
 def test06_pathtracer_is_finite_and_non_negative(ball, floor, light_list, seed):
-    from app.raytrace.pathtrace import iter_pathtrace
+    from shadelab.raytrace.pathtrace import iter_pathtrace
 
     floor.emission = (1.0, 1.0, 1.0)                     # the path tracer needs an emitter
     steps = list(iter_pathtrace(_trace_scene(ball, floor, light_list), (10, 8), 2, seed))
@@ -216,7 +216,7 @@ def _room(rho: list[float], emitter: int, radiance: float) -> Scene:
     return scene
 
 
-@pytest.mark.skipif(not _has("app.radiosity.solvers"), reason="radiosity not built yet")
+@pytest.mark.skipif(not _has("shadelab.radiosity.solvers"), reason="radiosity not built yet")
 @settings(max_examples=15, deadline=None)
 @given(rho=st.lists(st.floats(0.0, 0.95), min_size=6, max_size=6),
        emitter=st.integers(0, 5), radiance=st.floats(0.01, 100.0),
@@ -224,9 +224,9 @@ def _room(rho: list[float], emitter: int, radiance: float) -> Scene:
        count=st.integers(6, 60))
 def test07_radiosity_creates_no_energy(rho, emitter, radiance, solver, count):
     """B >= E, B <= E_max / (1 - rho_max), and absorbed power <= emitted power (rho < 1)."""
-    from app.radiosity.formfactors import FormFactors
-    from app.radiosity.patches import uniform_patches
-    from app.radiosity.solvers import solve
+    from shadelab.radiosity.formfactors import FormFactors
+    from shadelab.radiosity.patches import uniform_patches
+    from shadelab.radiosity.solvers import solve
 
     patches = uniform_patches(_room(rho, emitter, radiance), count)
     F = FormFactors(patches, "raycast").matrix()

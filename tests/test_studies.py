@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from app.cli import main
-from app.scene.model import Camera, Light, Material, Object, Scene
-from app.studies.shading_study import exact_sphere_image
+from shadelab.cli import main
+from shadelab.scene.model import Camera, Light, Material, Object, Scene
+from shadelab.studies.shading_study import exact_sphere_image
 
 
 def _lambert_scene(distance: float = 4.0) -> Scene:
@@ -43,7 +43,7 @@ def test02_exact_sphere_rejects_ellipsoids():
 
 @pytest.fixture(scope="module")
 def shading_rows(gl_ctx):
-    from app.studies.shading_study import run_shading
+    from shadelab.studies.shading_study import run_shading
 
     return run_shading(quick=True)
 
@@ -97,9 +97,9 @@ def test07_charts_bad_input(tmp_path, capsys):
 
 @pytest.mark.gl
 def test08_shadow_study_agrees_with_rays_except_zpass_inside(gl_ctx):
-    pytest.importorskip("app.render.shadows")
-    pytest.importorskip("app.raytrace.surface")
-    from app.studies.shadow_study import run_shadows
+    pytest.importorskip("shadelab.render.shadows")
+    pytest.importorskip("shadelab.raytrace.surface")
+    from shadelab.studies.shadow_study import run_shadows
 
     result = run_shadows(quick=True)
     for row in result.records():
@@ -113,8 +113,8 @@ def test08_shadow_study_agrees_with_rays_except_zpass_inside(gl_ctx):
 
 
 def test09_raytrace_study_depth_and_samples_help():
-    pytest.importorskip("app.raytrace.whitted")
-    from app.studies.raytrace_study import run_raytrace
+    pytest.importorskip("shadelab.raytrace.whitted")
+    from shadelab.studies.raytrace_study import run_raytrace
 
     result = run_raytrace(quick=True)
     err = {(r["depth"], r["spp"]): r["relmse"] for r in result.records()}
@@ -125,8 +125,8 @@ def test09_raytrace_study_depth_and_samples_help():
 
 @pytest.mark.gl
 def test10_radiosity_study(gl_ctx):
-    pytest.importorskip("app.radiosity.solution")
-    from app.studies.radiosity_study import run_radiosity
+    pytest.importorskip("shadelab.radiosity.solution")
+    from shadelab.studies.radiosity_study import run_radiosity
 
     result = run_radiosity(quick=True)
     rows = result.records()
@@ -145,7 +145,7 @@ def test10_radiosity_study(gl_ctx):
 
 
 def test11_viewer_registry():
-    from app.studies import STUDIES, StudySkipped, run_study
+    from shadelab.studies import STUDIES, StudySkipped, run_study
 
     assert [name for name, _ in STUDIES] == ["shading", "raytrace", "radiosity", "shadows"]
     assert all(title for _, title in STUDIES)

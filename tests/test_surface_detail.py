@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from app.render.textures import srgb_to_linear
-from app.scene.camera import primary_rays
-from app.scene.model import Camera, Light, Material, Object, Scene
+from shadelab.render.textures import srgb_to_linear
+from shadelab.scene.camera import primary_rays
+from shadelab.scene.model import Camera, Light, Material, Object, Scene
 
 pytestmark = pytest.mark.gl
 
@@ -37,7 +37,7 @@ def pixel_uv(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
 
 
 def render(scene: Scene, shading: str) -> np.ndarray:
-    from app.render.offscreen import render_image
+    from shadelab.render.offscreen import render_image
 
     return render_image(scene, SIZE, shading)
 
@@ -111,7 +111,7 @@ def test_bumps_show_in_flat_and_gouraud_too(gl_ctx, shading):
 @pytest.mark.parametrize("shading", ["flat", "gouraud", "phong"])
 def test_untextured_material_output_is_unchanged(gl_ctx, shading):
     """Materials without texture or bump go through the plain programs: the same pixels."""
-    from app.scene import load_preset
+    from shadelab.scene import load_preset
 
     scene = load_preset("surface-detail")
     textured = render(scene, shading)
@@ -134,7 +134,7 @@ def test_untextured_material_output_is_unchanged(gl_ctx, shading):
 
 
 def test_missing_texture_is_a_one_line_error(tmp_path, capsys):
-    from app.cli import main
+    from shadelab.cli import main
 
     code = main(["render", "shadows", "-o", str(tmp_path / "x.png"), "--size", "16x12",
                  "--set", "materials.red.texture=nope.png"])

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app.render.transparency import blend_reference
-from app.scene.model import Camera, Material, Object, Scene
+from shadelab.render.transparency import blend_reference
+from shadelab.scene.model import Camera, Material, Object, Scene
 
 pytestmark = pytest.mark.gl
 
@@ -53,7 +53,7 @@ def expected(scene: Scene, layers: list[str], behind) -> np.ndarray:
 @pytest.mark.parametrize("shading", ["flat", "gouraud", "phong"])
 @pytest.mark.parametrize("opaque_back", [False, True])
 def test_stack_of_quads_matches_the_formulas(gl_ctx, shading, opaque_back):
-    from app.render.offscreen import render_image
+    from shadelab.render.offscreen import render_image
 
     scene = stack_scene(opaque_back)
     image = render_image(scene, SIZE, shading)
@@ -73,7 +73,7 @@ def test_stack_of_quads_matches_the_formulas(gl_ctx, shading, opaque_back):
 
 
 def test_order_of_objects_does_not_matter(gl_ctx):
-    from app.render.offscreen import render_image
+    from shadelab.render.offscreen import render_image
 
     scene = stack_scene(True)
     first = render_image(scene, SIZE)
@@ -90,8 +90,8 @@ def test_formulas():
 
 
 def test_preset_renders_all_models(gl_ctx):
-    from app.render.offscreen import render_image
-    from app.scene import load_preset
+    from shadelab.render.offscreen import render_image
+    from shadelab.scene import load_preset
 
     scene = load_preset("transparency")
     models = {m.transparency for m in scene.materials.values() if m.kt > 0}

@@ -8,14 +8,14 @@ import time
 import numpy as np
 import pytest
 
-from app.cli import main
-from app.progress import Progress
-from app.scene import load_preset
-from app.scene.preset import scene_to_dict
-from app.ui.app import orbit, pan, zoom
-from app.ui.jobs import JobRunner, difference, iter_reference_raster
-from app.ui.probe import probe
-from app.ui.state import AppState, History, autosave_path, load_session, save_session
+from shadelab.cli import main
+from shadelab.progress import Progress
+from shadelab.scene import load_preset
+from shadelab.scene.preset import scene_to_dict
+from shadelab.ui.app import orbit, pan, zoom
+from shadelab.ui.jobs import JobRunner, difference, iter_reference_raster
+from shadelab.ui.probe import probe
+from shadelab.ui.state import AppState, History, autosave_path, load_session, save_session
 
 # ---------------------------------------------------------------- command line
 
@@ -55,7 +55,7 @@ def test_view_bad_input_is_one_line_exit_2(monkeypatch, capsys, argv, expected):
 @pytest.mark.parametrize("specular", ["phong", "blinn"])
 def test_probe_terms_match_the_gpu_pixel(gl_ctx, preset, shading, specular):
     """The probe's reference sum equals what the GPU drew (rtol 1e-4, atol 1e-5)."""
-    from app.ui.viewport import Viewport
+    from shadelab.ui.viewport import Viewport
 
     scene = load_preset(preset)
     for m in scene.materials.values():  # give every surface a highlight to check
@@ -84,8 +84,8 @@ def test_probe_terms_match_the_gpu_pixel(gl_ctx, preset, shading, specular):
 
 @pytest.mark.gl
 def test_display_pass_is_exposure_then_srgb_and_heat_map_of_equal_images_is_black(gl_ctx):
-    from app.shading.conventions import to_srgb8
-    from app.ui.viewport import Viewport
+    from shadelab.shading.conventions import to_srgb8
+    from shadelab.ui.viewport import Viewport
 
     scene = load_preset("cornell")
     vp = Viewport(gl_ctx)
@@ -108,7 +108,7 @@ def test_display_pass_is_exposure_then_srgb_and_heat_map_of_equal_images_is_blac
 
 @pytest.mark.gl
 def test_reference_raster_job_matches_the_gpu_image(gl_ctx):
-    from app.render.offscreen import render_image
+    from shadelab.render.offscreen import render_image
 
     scene = load_preset("cornell")
     steps = list(iter_reference_raster(scene, (40, 30), rows_per_chunk=8))
@@ -272,7 +272,7 @@ def test_job_runs_to_the_end_and_reports_errors():
 
 
 def test_available_jobs_lists_every_renderer_with_a_reason_when_missing():
-    from app.ui.jobs import available_jobs
+    from shadelab.ui.jobs import available_jobs
 
     kinds = available_jobs()
     labels = [k.label for k in kinds]
@@ -283,7 +283,7 @@ def test_available_jobs_lists_every_renderer_with_a_reason_when_missing():
 
 
 def test_legend_is_burned_into_the_bottom_band():
-    from app.ui.legend import burn_legend, legend_lines
+    from shadelab.ui.legend import burn_legend, legend_lines
 
     state = AppState.from_scene(load_preset("cornell"), "cornell")
     image = np.full((200, 300, 3), 128, np.uint8)
@@ -297,7 +297,7 @@ def test_legend_is_burned_into_the_bottom_band():
 def test_overlays_ray_tree_and_radiosity_soup_shapes_and_colors():
     from types import SimpleNamespace
 
-    from app.ui import overlays
+    from shadelab.ui import overlays
 
     node = SimpleNamespace
     leaf = node(kind="shadow", origin=np.zeros(3), direction=np.array([0.0, 1.0, 0.0]),
@@ -317,8 +317,8 @@ def test_overlays_ray_tree_and_radiosity_soup_shapes_and_colors():
 
 
 def test_wireframe_and_normal_glyphs_follow_the_mesh():
-    from app.geometry.mesh import scene_meshes
-    from app.ui import overlays
+    from shadelab.geometry.mesh import scene_meshes
+    from shadelab.ui import overlays
 
     meshes = scene_meshes(load_preset("cornell"))
     faces = sum(len(m.faces) for m in meshes)
@@ -334,7 +334,7 @@ def test_view_restores_the_autosaved_session_unless_fresh_or_another_preset(tmp_
                                                                           monkeypatch, capsys):
     import argparse
 
-    from app.ui.commands import load_scene
+    from shadelab.ui.commands import load_scene
 
     monkeypatch.setenv("XDG_STATE_HOME", str(tmp_path / "xdg"))
     scene = load_preset("cornell")
@@ -357,7 +357,7 @@ def test_view_restores_the_autosaved_session_unless_fresh_or_another_preset(tmp_
 
 
 def test_a_picklable_job_runs_in_the_worker_process_and_cancels():
-    from app.ui.jobs import iter_reference_raster
+    from shadelab.ui.jobs import iter_reference_raster
 
     scene = load_preset("cornell")
     runner = JobRunner()
@@ -392,7 +392,7 @@ def test_open_a_mesh_file_adds_it_and_a_broken_one_keeps_the_scene(tmp_path):
     assert state.open_file(str(good)) and len(state.scene.objects) == count + 1
     added = state.scene.objects[-1]
     assert added.shape == "mesh" and added.material in state.scene.materials
-    from app.geometry.mesh import scene_bounds, scene_meshes
+    from shadelab.geometry.mesh import scene_bounds, scene_meshes
 
     lo, hi = scene_bounds([scene_meshes(state.scene)[-1]])
     assert np.max(hi - lo) == pytest.approx(0.3 * 800.0, rel=1e-6)  # fitted to the view

@@ -1,8 +1,0 @@
-"""``python -m app`` is the same as the ``shadelab`` command."""
-
-import sys
-
-if __name__ == "__main__":  # spawned worker processes import this module without running it
-    from app.cli import main
-
-    sys.exit(main())

@@ -1,0 +1,102 @@
+"""``shadelab bench``: performance figures as JSON (medians, with the machine).
+
+Each layer contributes a section module with ``run(quick: bool) -> dict``; a section whose
+module is not built yet is skipped. Speed is measured here, never asserted by a timed test.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import os
+import platform
+import statistics
+import sys
+import time
+from typing import Callable
+
+SECTIONS = (
+    ("raster", "shadelab.render.bench"),
+    ("shadows", "shadelab.render.bench_shadows"),
+    ("viewer", "shadelab.ui.bench"),
+    ("raytrace", "shadelab.raytrace.bench"),
+    ("radiosity", "shadelab.radiosity.bench"),
+)
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("bench", help="performance figures as JSON")
+    p.add_argument("--json", metavar="OUT.json", help="write the figures here")
+    p.add_argument("--quick", action="store_true", help="fewer frames and samples (smoke run)")
+    p.add_argument("--only", action="append", default=[], metavar="SECTION",
+                   help=f"run only these sections ({', '.join(s for s, _ in SECTIONS)})")
+    p.set_defaults(run=run)
+
+
+def machine() -> dict:
+    """What the figures were measured on."""
+    cpu = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    cpu = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    info = {"cpu": cpu, "cores": os.cpu_count(), "python": sys.version.split()[0],
+            "platform": platform.platform()}
+    try:
+        from shadelab.gl.context import headless_context
+
+        ctx = headless_context()
+        info["gl_renderer"] = ctx.info["GL_RENDERER"]
+        info["gl_version"] = ctx.info["GL_VERSION"]
+    except Exception as exc:  # the bench still reports CPU sections without GL
+        info["gl_renderer"] = f"unavailable: {exc}"
+    return info
+
+
+def median_time(fn: Callable[[], object], repeats: int, warmup: int = 2) -> dict:
+    """Median, min and max wall time of ``fn`` in milliseconds."""
+    for _ in range(warmup):
+        fn()
+    samples = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        fn()
+        samples.append((time.perf_counter() - start) * 1000.0)
+    return {"median_ms": statistics.median(samples), "min_ms": min(samples),
+            "max_ms": max(samples), "repeats": repeats}
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.json:
+        from shadelab.imageio import check_writable
+
+        check_writable(args.json, "--json")
+    known = {name for name, _ in SECTIONS}
+    for name in args.only:
+        if name not in known:
+            from shadelab.errors import ShadeLabError
+
+            raise ShadeLabError(f"--only '{name}': expected one of {', '.join(sorted(known))}")
+    report = {"machine": machine(), "quick": bool(args.quick), "sections": {}}
+    for name, module_name in SECTIONS:
+        if args.only and name not in args.only:
+            continue
+        try:
+            module = importlib.import_module(module_name)
+        except ModuleNotFoundError as exc:
+            if exc.name and module_name.startswith(exc.name):
+                continue
+            raise
+        print(f"bench: {name} ...", file=sys.stderr, flush=True)
+        report["sections"][name] = module.run(bool(args.quick))
+    text = json.dumps(report, indent=2)
+    if args.json:
+        with open(args.json, "w", encoding="utf-8") as f:
+            f.write(text + "\n")
+    print(text)
+    return 0

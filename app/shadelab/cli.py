@@ -1,0 +1,70 @@
+"""The ``shadelab`` command line (a stable contract; see README "Command line").
+
+Each subcommand lives in its layer as a module with ``add_parser(subparsers)`` and
+``run(args) -> int``; this file only dispatches. Bad input raises :class:`ShadeLabError`,
+printed here as one line, exit code 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from shadelab.errors import ShadeLabError
+
+# Modules that contribute subcommands, in help order.
+COMMAND_MODULES = (
+    "shadelab.render.commands",
+    "shadelab.raytrace.commands",
+    "shadelab.radiosity.commands",
+    "shadelab.studies.commands",
+    "shadelab.bench",
+    "shadelab.ui.commands",
+)
+
+EXIT_BAD_INPUT = 2
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse that reports usage errors as our one-line error with exit code 2."""
+
+    def error(self, message: str):  # noqa: D102
+        raise ShadeLabError(f"{self.prog}: {message}")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="shadelab",
+                     description="ShadeLab: an interactive lab for illumination and shading. "
+                                 "Run 'shadelab [PRESET]' to open the viewer (default: cornell).")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    for name in COMMAND_MODULES:
+        try:
+            module = importlib.import_module(name)
+        except ModuleNotFoundError as exc:
+            if exc.name and name.startswith(exc.name):  # a layer not built yet: no command
+                continue
+            raise
+        module.add_parser(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser()
+    commands = set(parser._subparsers._group_actions[0].choices)  # noqa: SLF001
+    if not argv or (argv[0] not in commands and argv[0] not in ("-h", "--help")):
+        argv = ["view", *argv]  # 'shadelab [PRESET] [view options]' opens the viewer
+    try:
+        args = parser.parse_args(argv)
+        return int(args.run(args) or 0)
+    except ShadeLabError as exc:
+        print(f"shadelab: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        print("shadelab: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

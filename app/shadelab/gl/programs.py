@@ -1,0 +1,59 @@
+"""Load GLSL programs from ``shaders/``: one file per stage, chunks from ``shaders/include``.
+
+Chunks are registered as moderngl named includes (``#include "lighting"``).
+"""
+
+from __future__ import annotations
+
+import moderngl
+
+from shadelab.resources import shaders_dir
+
+
+def register_includes(ctx: moderngl.Context) -> None:
+    for path in sorted((shaders_dir() / "include").glob("*.glsl")):
+        ctx.includes[path.stem] = path.read_text(encoding="utf-8")
+
+
+def with_defines(source: str, defines: dict[str, object] | None) -> str:
+    """Insert ``#define NAME VALUE`` lines right after the ``#version`` line."""
+    if not defines:
+        return source
+    first, _, rest = source.partition("\n")
+    lines = "".join(f"#define {key} {value}\n" for key, value in defines.items())
+    return f"{first}\n{lines}{rest}"
+
+
+def load_program(ctx: moderngl.Context, name: str,
+                 defines: dict[str, object] | None = None) -> moderngl.Program:
+    """Compile ``shaders/<name>.vert`` and ``<name>.frag`` (and ``<name>.geom`` if present),
+    with optional ``#define``s (e.g. ``NUM_LIGHTS``) inserted in every stage."""
+    register_includes(ctx)
+    folder = shaders_dir()
+    stages = {"vertex_shader": "vert", "fragment_shader": "frag", "geometry_shader": "geom"}
+    sources = {}
+    for stage, suffix in stages.items():
+        path = folder / f"{name}.{suffix}"
+        if path.is_file():
+            sources[stage] = with_defines(path.read_text(encoding="utf-8"), defines)
+    return ctx.program(**sources)
+
+
+def set_uniform(program: moderngl.Program, name: str, value) -> None:
+    """Set a uniform if the compiler kept it (unused uniforms are optimized away)."""
+    if name not in program:
+        return
+    uniform = program[name]
+    if isinstance(value, (bytes, bytearray)):
+        uniform.write(value)
+    else:
+        uniform.value = value
+
+
+def set_uniform_array(program: moderngl.Program, name: str, array) -> None:
+    """Write a uniform array; the compiler may have trimmed unused trailing elements."""
+    if name not in program:
+        return
+    uniform = program[name]
+    count = max(uniform.array_length, 1)
+    uniform.write(array[:count].tobytes())

@@ -1,0 +1,301 @@
+"""The scene's surfaces cut into radiosity patches: regular grids, refined where B changes fast.
+
+Quads and planes are *surfaces* meshed by a quadtree over their (u, v) parameter square: a
+regular base grid of about the target patch size, whose cells (leaves) can be split into four
+where the radiosity changes fast (shadow boundaries, corners), so that flat regions stay
+coarse. Leaves are stored in integer coordinates at the finest level (``FINE`` units per base
+cell), which lets the display find T-vertices exactly. Any other shape (spheres, boxes, mesh
+files) keeps its triangles, each cut regularly into k x k smaller ones with the same k over the
+whole object, which is conforming by construction.
+
+Every patch is stored as a 4-corner polygon (a triangle repeats its last corner), counter-
+clockwise seen from the front: the form factors, the hemicube and the display read one layout.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from shadelab.errors import ShadeLabError
+from shadelab.geometry.mesh import scene_meshes
+from shadelab.scene.model import Scene
+
+MAX_LEVEL = 6  # quadtree depth below the base grid
+FINE = 1 << MAX_LEVEL  # integer units per base cell edge
+
+
+@dataclass
+class Surface:
+    """One object's meshing domain.
+
+    Attributes
+    ----------
+    kind : "quad" (bilinear quadtree) or "mesh" (regularly split triangles)
+    corners : (4, 3) float64 world corners of a quad surface, counter-clockwise from the front
+    grid : (nu, nv) base cells of a quad surface
+    vertices, faces : the split triangles of a mesh surface (world space)
+    """
+
+    object_index: int
+    material: str
+    kind: str
+    corners: np.ndarray | None = None
+    grid: tuple[int, int] = (1, 1)
+    vertices: np.ndarray | None = None
+    faces: np.ndarray | None = None
+
+    def point(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """World points of integer quadtree coordinates (x along u, y along v)."""
+        u = np.asarray(x, float) / (self.grid[0] * FINE)
+        v = np.asarray(y, float) / (self.grid[1] * FINE)
+        p0, p1, p2, p3 = self.corners
+        return (((1 - u) * (1 - v))[..., None] * p0 + (u * (1 - v))[..., None] * p1
+                + (u * v)[..., None] * p2 + ((1 - u) * v)[..., None] * p3)
+
+
+@dataclass
+class PatchSet:
+    """Patches of a scene, the unknowns of the radiosity system.
+
+    Attributes
+    ----------
+    polygons : (N, 4, 3) float64 world corners, counter-clockwise from the front
+    normals : (N, 3) unit; areas : (N,) world units squared; centers : (N, 3)
+    rho : (N, 3) reflectance kd * Od; emission : (N, 3) emitted radiance Le (E = pi * Le)
+    surface : (N,) index into ``surfaces``
+    rects : (N, 4) int quadtree leaf (x0, y0, x1, y1) on quad surfaces, -1 elsewhere
+    tri : (N, 3) int vertex indices into the surface's vertices on mesh surfaces, -1 elsewhere
+    """
+
+    surfaces: list[Surface]
+    polygons: np.ndarray
+    normals: np.ndarray
+    areas: np.ndarray
+    centers: np.ndarray
+    rho: np.ndarray
+    emission: np.ndarray
+    surface: np.ndarray
+    rects: np.ndarray
+    tri: np.ndarray
+    info: dict = field(default_factory=dict)
+
+    def __len__(self) -> int:
+        return len(self.areas)
+
+    @property
+    def E(self) -> np.ndarray:
+        """(N, 3) emitted radiosity, pi * Le."""
+        return math.pi * self.emission
+
+
+def check_count(count: int, key: str = "--patches") -> int:
+    if not isinstance(count, (int, np.integer)) or isinstance(count, bool) or count < 1:
+        raise ShadeLabError(f"{key} {count!r}: expected a patch count >= 1")
+    return int(count)
+
+
+def polygon_area_normal(poly: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Areas (N,) and unit normals (N, 3) of (N, 4, 3) planar polygons (Newell's vector)."""
+    cross = np.zeros(poly.shape[:-2] + (3,))
+    for k in range(4):
+        cross += np.cross(poly[..., k, :], poly[..., (k + 1) % 4, :])
+    length = np.linalg.norm(cross, axis=-1)
+    return 0.5 * length, cross / np.maximum(length, 1e-300)[..., None]
+
+
+def scene_surfaces(scene: Scene) -> list[Surface]:
+    """One meshing surface per object: quads and planes by their corners, the rest as triangles."""
+    surfaces = []
+    for mesh, obj in zip(scene_meshes(scene), scene.objects, strict=True):
+        if obj.shape in ("quad", "plane"):
+            s = obj.segments
+            corners = mesh.vertices[[0, s, (s + 1) ** 2 - 1, (s + 1) * s]]
+            surfaces.append(Surface(mesh.index, obj.material, "quad", corners=corners.copy()))
+        else:
+            surfaces.append(Surface(mesh.index, obj.material, "mesh",
+                                    vertices=np.asarray(mesh.vertices, float),
+                                    faces=np.asarray(mesh.faces, np.int64)))
+    return surfaces
+
+
+def _quad_grid(corners: np.ndarray, h: float) -> tuple[int, int]:
+    """Base cells along u and v so that cells are about h wide."""
+    p0, p1, p2, p3 = corners
+    lu = 0.5 * (np.linalg.norm(p1 - p0) + np.linalg.norm(p2 - p3))
+    lv = 0.5 * (np.linalg.norm(p3 - p0) + np.linalg.norm(p2 - p1))
+    return max(1, int(round(lu / h))), max(1, int(round(lv / h)))
+
+
+def _mesh_split(vertices: np.ndarray, faces: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """Cut each triangle into k*k; shared edges are cut the same way, vertices merged."""
+    if k <= 1:
+        return vertices, faces
+    points, tris = [], []
+    for a, b, c in vertices[faces]:
+        base = len(points)
+        index = {}
+        for i in range(k + 1):
+            for j in range(k + 1 - i):
+                index[i, j] = base + len(index)
+                points.append(a + (b - a) * (i / k) + (c - a) * (j / k))
+        for i in range(k):
+            for j in range(k - i):
+                tris.append((index[i, j], index[i + 1, j], index[i, j + 1]))
+                if i + j < k - 1:
+                    tris.append((index[i + 1, j], index[i + 1, j + 1], index[i, j + 1]))
+    points = np.asarray(points)
+    scale = max(float(np.ptp(points, axis=0).max()), 1e-12)
+    keys = np.round(points / (scale * 1e-9)).astype(np.int64)
+    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+    return points[first], inverse.reshape(-1)[np.asarray(tris)]
+
+
+def _surface_area(surface: Surface) -> float:
+    if surface.kind == "quad":
+        return float(polygon_area_normal(surface.corners[None])[0][0])
+    tri = surface.vertices[surface.faces]
+    return float(0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]),
+                                      axis=1).sum())
+
+
+def _count_for(surfaces: list[Surface], h: float) -> int:
+    total = 0
+    for s in surfaces:
+        if s.kind == "quad":
+            nu, nv = _quad_grid(s.corners, h)
+            total += nu * nv
+        else:
+            per = _surface_area(s) / max(len(s.faces), 1)
+            total += len(s.faces) * max(1, int(round(math.sqrt(per) / h))) ** 2
+    return total
+
+
+def uniform_patches(scene: Scene, count: int) -> PatchSet:
+    """A regular meshing with about ``count`` patches of equal size (no refinement)."""
+    count = check_count(count)
+    surfaces = scene_surfaces(scene)
+    if not surfaces:
+        raise ShadeLabError("objects: the scene has no surfaces to mesh into patches")
+    total = sum(_surface_area(s) for s in surfaces)
+    # Find the patch size h whose meshing comes closest to the target count (bisection on log h)
+    # (capped near the mean patch size, so that mesh objects, which keep one patch per
+    # triangle at least, do not leave the quads a single patch each)
+    lo, hi = math.sqrt(total / count) / 8.0, math.sqrt(total / count) * 1.5
+    for _ in range(40):
+        mid = math.sqrt(lo * hi)
+        if _count_for(surfaces, mid) > count:
+            lo = mid
+        else:
+            hi = mid
+    # Counts jump as grids gain a row: take the side of the jump closer to the target
+    h = lo if abs(_count_for(surfaces, lo) - count) < abs(_count_for(surfaces, hi) - count) \
+        else hi
+    leaves = []
+    for index, s in enumerate(surfaces):
+        if s.kind == "quad":
+            s.grid = _quad_grid(s.corners, h)
+            for i in range(s.grid[0]):
+                for j in range(s.grid[1]):
+                    leaves.append((index, i * FINE, j * FINE, (i + 1) * FINE, (j + 1) * FINE))
+        else:
+            per = _surface_area(s) / max(len(s.faces), 1)
+            k = max(1, int(round(math.sqrt(per) / h)))
+            s.vertices, s.faces = _mesh_split(s.vertices, s.faces, k)
+    return assemble(scene, surfaces, leaves)
+
+
+def assemble(scene: Scene, surfaces: list[Surface], leaves: list[tuple]) -> PatchSet:
+    """Build the patch arrays from quad leaves plus every mesh surface's triangles."""
+    polygons, surface_of, rects, tris = [], [], [], []
+    for index, x0, y0, x1, y1 in leaves:
+        s = surfaces[index]
+        polygons.append(s.point(np.array([x0, x1, x1, x0]), np.array([y0, y0, y1, y1])))
+        surface_of.append(index)
+        rects.append((x0, y0, x1, y1))
+        tris.append((-1, -1, -1))
+    for index, s in enumerate(surfaces):
+        if s.kind != "mesh":
+            continue
+        for face in s.faces:
+            polygons.append(s.vertices[[face[0], face[1], face[2], face[2]]])
+            surface_of.append(index)
+            rects.append((-1, -1, -1, -1))
+            tris.append(tuple(face))
+    polygons = np.asarray(polygons, float).reshape(-1, 4, 3)
+    areas, normals = polygon_area_normal(polygons)
+    surface_of = np.asarray(surface_of, np.int64)
+    rho = np.zeros((len(areas), 3))
+    emission = np.zeros((len(areas), 3))
+    for index, s in enumerate(surfaces):
+        material = scene.materials[s.material]
+        mask = surface_of == index
+        rho[mask] = material.kd * np.asarray(material.Od, float)
+        emission[mask] = material.emission
+    keep = areas > 1e-12 * max(float(areas.max(initial=0.0)), 1e-300)
+    centers = (polygons * _corner_weights(polygons)[..., None]).sum(axis=1)
+    patches = PatchSet(surfaces, polygons[keep], normals[keep], areas[keep], centers[keep],
+                       rho[keep], emission[keep], surface_of[keep],
+                       np.asarray(rects, np.int64).reshape(-1, 4)[keep],
+                       np.asarray(tris, np.int64).reshape(-1, 3)[keep])
+    patches.info["patches"] = len(patches)
+    return patches
+
+
+def _corner_weights(polygons: np.ndarray) -> np.ndarray:
+    """Weights giving the area centroid of each polygon from its 4 corners (two triangles)."""
+    a0 = 0.5 * np.linalg.norm(np.cross(polygons[:, 1] - polygons[:, 0],
+                                       polygons[:, 2] - polygons[:, 0]), axis=1)
+    a1 = 0.5 * np.linalg.norm(np.cross(polygons[:, 2] - polygons[:, 0],
+                                       polygons[:, 3] - polygons[:, 0]), axis=1)
+    total = np.maximum(a0 + a1, 1e-300)
+    w = np.zeros((len(polygons), 4))
+    w[:, [0, 1, 2]] += (a0 / total / 3.0)[:, None]
+    w[:, [0, 2, 3]] += (a1 / total / 3.0)[:, None]
+    return w
+
+
+def leaves_of(patches: PatchSet) -> list[tuple]:
+    """The quad leaves (surface, x0, y0, x1, y1) of a patch set."""
+    quad = patches.rects[:, 0] >= 0
+    pairs = zip(patches.surface[quad], patches.rects[quad], strict=True)
+    return [(int(s), *map(int, r)) for s, r in pairs]
+
+
+def split_leaves(scene: Scene, patches: PatchSet, chosen: np.ndarray) -> PatchSet:
+    """Split the chosen quad patches (indices) into four children each."""
+    chosen = set(int(i) for i in chosen)
+    leaves = []
+    for i in np.flatnonzero(patches.rects[:, 0] >= 0):
+        s = int(patches.surface[i])
+        x0, y0, x1, y1 = map(int, patches.rects[i])
+        if i in chosen and x1 - x0 > 1:
+            xm, ym = (x0 + x1) // 2, (y0 + y1) // 2
+            leaves += [(s, x0, y0, xm, ym), (s, xm, y0, x1, ym), (s, xm, ym, x1, y1),
+                       (s, x0, ym, xm, y1)]
+        else:
+            leaves.append((s, x0, y0, x1, y1))
+    return assemble(scene, patches.surfaces, leaves)
+
+
+def from_polygons(polygons, rho=0.0, emission=0.0) -> PatchSet:
+    """A patch set straight from (N, 4, 3) or (N, 3, 3) polygons (tests, teaching examples).
+
+    ``rho`` and ``emission`` broadcast to (N, 3).
+    """
+    polygons = np.asarray(polygons, float)
+    if polygons.shape[1] == 3:
+        polygons = polygons[:, [0, 1, 2, 2]]
+    n = len(polygons)
+    areas, normals = polygon_area_normal(polygons)
+    centers = (polygons * _corner_weights(polygons)[..., None]).sum(axis=1)
+    rho = np.broadcast_to(np.asarray(rho, float).reshape(-1, 1) if np.ndim(rho) == 1
+                          and len(rho) == n else np.asarray(rho, float), (n, 3)).copy()
+    emission = np.broadcast_to(np.asarray(emission, float).reshape(-1, 1)
+                               if np.ndim(emission) == 1 and len(emission) == n
+                               else np.asarray(emission, float), (n, 3)).copy()
+    return PatchSet([], polygons, normals, areas, centers, rho, emission,
+                    np.zeros(n, np.int64), np.full((n, 4), -1, np.int64),
+                    np.full((n, 3), -1, np.int64), {"patches": n})

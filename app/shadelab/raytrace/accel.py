@@ -1,0 +1,189 @@
+"""Ray casting against the scene's triangles: Embree (``embreex``) or a numba BVH fallback.
+
+Both backends answer the same two questions over batches of rays (float64 in, world space):
+
+- :meth:`intersect` -> :class:`Hits` (closest hit: distance, triangle, barycentrics u, v with
+  ``p = (1 - u - v) p0 + u p1 + v p2``), and
+- :meth:`occluded` -> bool (is anything closer than ``tmax``?), against the shadow casters
+  only (objects with ``cast_shadows = false``, such as the Cornell light, let shadow rays pass).
+
+Rays start at their origin (t >= 0): callers offset origins off the surface themselves, so the
+offset is visible and testable (shadow acne appears when it is 0).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from shadelab.geometry.mesh import MeshData, scene_meshes
+from shadelab.raytrace import BACKENDS  # noqa: F401  (re-exported: accel.BACKENDS)
+from shadelab.scene.model import Scene
+
+T_INF = 1e30  # "no hit" distance, world units
+
+
+@dataclass
+class SceneGeometry:
+    """Every triangle of the scene in one flat array, with what a shader needs per triangle.
+
+    Attributes
+    ----------
+    triangles : (F, 3, 3) float64 corner positions, world space
+    face_normals : (F, 3) float64, unit, counter-clockwise front
+    corner_normals : (F, 3, 3) float64, unit, by each object's normals mode
+    object_index : (F,) int64, index into ``scene.objects``
+    casts_shadow : (F,) bool, the object's ``cast_shadows``
+    diagonal : length of the scene's bounding-box diagonal, world units
+    """
+
+    triangles: np.ndarray
+    face_normals: np.ndarray
+    corner_normals: np.ndarray
+    object_index: np.ndarray
+    casts_shadow: np.ndarray
+    diagonal: float
+
+    @property
+    def count(self) -> int:
+        return len(self.triangles)
+
+
+def scene_geometry(scene: Scene, meshes: list[MeshData] | None = None) -> SceneGeometry:
+    """Flatten the scene's meshes (the same triangles the raster draws)."""
+    meshes = scene_meshes(scene) if meshes is None else meshes
+    if not meshes or sum(len(m.faces) for m in meshes) == 0:
+        empty3 = np.zeros((0, 3, 3))
+        return SceneGeometry(empty3, np.zeros((0, 3)), empty3, np.zeros(0, np.int64),
+                             np.zeros(0, bool), 1.0)
+    triangles = np.concatenate([m.triangles for m in meshes])
+    face_n = np.concatenate([m.face_normals for m in meshes])
+    corner_n = np.concatenate([m.corner_normals for m in meshes])
+    object_index = np.concatenate([np.full(len(m.faces), m.index, np.int64) for m in meshes])
+    casts = np.array([scene.objects[i].cast_shadows for i in range(len(scene.objects))], bool)
+    lo = triangles.reshape(-1, 3).min(axis=0)
+    hi = triangles.reshape(-1, 3).max(axis=0)
+    diagonal = float(np.linalg.norm(hi - lo)) or 1.0
+    return SceneGeometry(triangles, face_n, corner_n, object_index, casts[object_index], diagonal)
+
+
+@dataclass
+class Hits:
+    """Closest hits of a batch of N rays; ``tri`` is -1 (and ``t`` is inf) for a miss."""
+
+    t: np.ndarray    # (N,) float64 distance along the unit direction
+    tri: np.ndarray  # (N,) int64 triangle index into SceneGeometry
+    u: np.ndarray    # (N,) float64 barycentric weight of corner 1
+    v: np.ndarray    # (N,) float64 barycentric weight of corner 2
+
+    @property
+    def hit(self) -> np.ndarray:
+        return self.tri >= 0
+
+
+class EmbreeAccel:
+    """Embree 4 through embreex: one scene of all triangles, one of the shadow casters."""
+
+    name = "embree"
+
+    def __init__(self, geometry: SceneGeometry):
+        from embreex import rtcore_scene
+        from embreex.mesh_construction import TriangleMesh
+
+        self.geometry = geometry
+        self._all = rtcore_scene.EmbreeScene()
+        self._casters = rtcore_scene.EmbreeScene()
+        tris = geometry.triangles.astype(np.float32)
+        self._caster_ids = np.flatnonzero(geometry.casts_shadow)
+        if len(tris):
+            TriangleMesh(self._all, tris)
+        if len(self._caster_ids):
+            TriangleMesh(self._casters, tris[self._caster_ids])
+
+    def intersect(self, origins: np.ndarray, dirs: np.ndarray,
+                  tmax: np.ndarray | None = None) -> Hits:
+        n = len(origins)
+        if n == 0 or self.geometry.count == 0:
+            return _misses(n)
+        o = np.ascontiguousarray(origins, dtype=np.float32)
+        d = np.ascontiguousarray(dirs, dtype=np.float32)
+        dists = None if tmax is None else np.ascontiguousarray(
+            np.minimum(tmax, T_INF), dtype=np.float32)
+        out = self._all.run(o, d, dists=dists, output=1)
+        tri = out["primID"].astype(np.int64)
+        hit = tri >= 0
+        t = np.where(hit, out["tfar"].astype(np.float64), np.inf)
+        return Hits(t, tri, out["u"].astype(np.float64), out["v"].astype(np.float64))
+
+    def occluded(self, origins: np.ndarray, dirs: np.ndarray, tmax: np.ndarray,
+                 everything: bool = False) -> np.ndarray:
+        """True where a shadow caster (any triangle with ``everything``) lies at t < tmax."""
+        n = len(origins)
+        target = self._all if everything else self._casters
+        if n == 0 or (self.geometry.count if everything else len(self._caster_ids)) == 0:
+            return np.zeros(n, bool)
+        o = np.ascontiguousarray(origins, dtype=np.float32)
+        d = np.ascontiguousarray(dirs, dtype=np.float32)
+        dists = np.ascontiguousarray(np.minimum(np.broadcast_to(tmax, (n,)), T_INF),
+                                     dtype=np.float32)
+        return target.run(o, d, dists=dists, query="OCCLUDED") != -1
+
+
+def _misses(n: int) -> Hits:
+    return Hits(np.full(n, np.inf), np.full(n, -1, np.int64), np.zeros(n), np.zeros(n))
+
+
+class BvhAccel:
+    """The numba BVH (see :mod:`shadelab.raytrace.bvh`): same answers, no Embree needed."""
+
+    name = "bvh"
+
+    def __init__(self, geometry: SceneGeometry):
+        from shadelab.raytrace import bvh
+
+        self.geometry = geometry
+        self._bvh = bvh
+        self._all = bvh.build(geometry.triangles)
+        self._caster_ids = np.flatnonzero(geometry.casts_shadow)
+        self._casters = bvh.build(geometry.triangles[self._caster_ids])
+
+    def intersect(self, origins: np.ndarray, dirs: np.ndarray,
+                  tmax: np.ndarray | None = None) -> Hits:
+        n = len(origins)
+        if n == 0 or self.geometry.count == 0:
+            return _misses(n)
+        limit = np.full(n, T_INF) if tmax is None else np.minimum(
+            np.broadcast_to(tmax, (n,)), T_INF).astype(np.float64)
+        t, tri, u, v = self._bvh.intersect(self._all, np.ascontiguousarray(origins, np.float64),
+                                           np.ascontiguousarray(dirs, np.float64), limit)
+        return Hits(np.where(tri >= 0, t, np.inf), tri, u, v)
+
+    def occluded(self, origins: np.ndarray, dirs: np.ndarray, tmax: np.ndarray,
+                 everything: bool = False) -> np.ndarray:
+        """True where a shadow caster (any triangle with ``everything``) lies at t < tmax."""
+        n = len(origins)
+        if n == 0 or (self.geometry.count if everything else len(self._caster_ids)) == 0:
+            return np.zeros(n, bool)
+        limit = np.minimum(np.broadcast_to(tmax, (n,)), T_INF).astype(np.float64)
+        tree = self._all if everything else self._casters
+        return self._bvh.occluded(tree, np.ascontiguousarray(origins, np.float64),
+                                  np.ascontiguousarray(dirs, np.float64), limit)
+
+
+def embree_available() -> bool:
+    try:
+        import embreex.mesh_construction  # noqa: F401
+        import embreex.rtcore_scene  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def build_accel(geometry: SceneGeometry, backend: str = "auto"):
+    """An :class:`EmbreeAccel` where embreex imports (``auto``), else a :class:`BvhAccel`."""
+    if backend not in BACKENDS:
+        raise ValueError(f"unknown backend {backend!r}")
+    if backend == "embree" or (backend == "auto" and embree_available()):
+        return EmbreeAccel(geometry)
+    return BvhAccel(geometry)

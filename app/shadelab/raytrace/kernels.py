@@ -1,0 +1,446 @@
+"""numba mirrors of the per-hit work, for speed: the surface frame at hits, shadow-ray setup,
+the lecture's local model, the spawning of Whitted's secondary rays and one path-tracer
+vertex (emission with MIS, next-event set-up, lobe choice, Russian roulette).
+
+:func:`local_shade` mirrors :func:`shadelab.shading.reference.shade` term by term (same guards:
+EPS = 1e-12, pow only where the cosine is positive, f_att = 1 at infinite distance);
+``tests/test_raytrace_kernels.py`` holds the two together on random inputs. The tracers use
+these kernels by default and the numpy reference with ``TraceContext(local="numpy")``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from shadelab.scene.model import Light, Material
+from shadelab.shading.reference import ATTENUATION_CODES
+
+EPS = 1e-12
+LIGHT_KIND_CODES = {"point": 0, "directional": 1, "spot": 2}
+
+# Material table columns
+M_KA, M_KD, M_KS, M_N, M_OD, M_OS, M_LE = 0, 1, 2, 3, 4, 7, 10
+MATERIAL_COLUMNS = 13
+# Light table columns
+L_KIND, L_POS, L_DIR, L_IP = 0, 1, 4, 7
+L_ATT, L_C1, L_C2, L_C3, L_COS, L_EXP = 10, 11, 12, 13, 14, 15
+LIGHT_COLUMNS = 16
+
+
+def material_table(materials: list[Material]) -> np.ndarray:
+    """(M, 13) float64: ka, kd, ks, n, Od, Os, emission."""
+    table = np.zeros((max(len(materials), 1), MATERIAL_COLUMNS))
+    for i, m in enumerate(materials):
+        table[i, :4] = (m.ka, m.kd, m.ks, m.n)
+        table[i, M_OD:M_OD + 3] = m.Od
+        table[i, M_OS:M_OS + 3] = m.Os
+        table[i, M_LE:M_LE + 3] = m.emission
+    return table
+
+
+def light_table(lights: list[Light]) -> np.ndarray:
+    """(L, 16) float64: kind, position, unit direction, Ip, attenuation, c1-c3, cos cone, e."""
+    table = np.zeros((len(lights), LIGHT_COLUMNS))
+    for i, light in enumerate(lights):
+        direction = np.asarray(light.direction, dtype=np.float64)
+        length = np.linalg.norm(direction)
+        table[i, L_KIND] = LIGHT_KIND_CODES[light.kind]
+        table[i, L_POS:L_POS + 3] = light.position
+        table[i, L_DIR:L_DIR + 3] = direction / length if length > EPS else 0.0
+        table[i, L_IP:L_IP + 3] = light.Ip
+        table[i, L_ATT] = ATTENUATION_CODES[light.attenuation]
+        table[i, L_C1:L_C3 + 1] = (light.c1, light.c2, light.c3)
+        table[i, L_COS] = math.cos(math.radians(light.cone_angle))
+        table[i, L_EXP] = light.spot_exponent
+    return table
+
+
+@nb.njit(cache=True, inline="always")
+def _to_light(lights, k, px, py, pz):
+    """Unit vector to light k and its distance (inf for a directional light)."""
+    if lights[k, L_KIND] == 1.0:
+        dx, dy, dz = -lights[k, L_DIR], -lights[k, L_DIR + 1], -lights[k, L_DIR + 2]
+        length = math.sqrt(dx * dx + dy * dy + dz * dz)
+        if length > EPS:
+            return dx / length, dy / length, dz / length, np.inf
+        return 0.0, 0.0, 0.0, np.inf
+    dx = lights[k, L_POS] - px
+    dy = lights[k, L_POS + 1] - py
+    dz = lights[k, L_POS + 2] - pz
+    length = math.sqrt(dx * dx + dy * dy + dz * dz)
+    if length > EPS:
+        return dx / length, dy / length, dz / length, length
+    return 0.0, 0.0, 0.0, length
+
+
+@nb.njit(cache=True, inline="always")
+def _power(c, n):
+    if c > 0.0:
+        return max(c, EPS) ** n
+    return 0.0
+
+
+@nb.njit(cache=True)
+def local_shade(position, normal, to_eye, mat, mats, lights, ia, blinn, shadow):
+    """The lecture's I (N, 3) at N points; ``shadow`` is (L, N) S_i."""
+    n_points = len(position)
+    out = np.empty((n_points, 3))
+    for i in range(n_points):
+        m = mat[i]
+        px, py, pz = position[i, 0], position[i, 1], position[i, 2]
+        nx, ny, nz = normal[i, 0], normal[i, 1], normal[i, 2]
+        vx, vy, vz = to_eye[i, 0], to_eye[i, 1], to_eye[i, 2]
+        ka, kd, ks, shininess = mats[m, M_KA], mats[m, M_KD], mats[m, M_KS], mats[m, M_N]
+        r = np.empty(3)
+        for c in range(3):
+            r[c] = mats[m, M_LE + c] + ia[c] * ka * mats[m, M_OD + c]
+        for k in range(len(lights)):
+            if (kd == 0.0 and ks == 0.0) or shadow[k, i] == 0.0:
+                continue  # adds exactly 0 (mirror, glass, or a shadowed light)
+            lx, ly, lz, dist = _to_light(lights, k, px, py, pz)
+            # f_att
+            att = lights[k, L_ATT]
+            if not math.isfinite(dist) or att == 0.0:
+                f_att = 1.0
+            elif att == 1.0:
+                f_att = 1.0 / max(dist * dist, EPS)
+            else:
+                den = lights[k, L_C1] + lights[k, L_C2] * dist + lights[k, L_C3] * dist * dist
+                f_att = min(1.0 / max(den, EPS), 1.0)
+            # spot cone
+            spot = 1.0
+            if lights[k, L_KIND] == 2.0:
+                cos_phi = -(lx * lights[k, L_DIR] + ly * lights[k, L_DIR + 1]
+                            + lz * lights[k, L_DIR + 2])
+                if cos_phi >= lights[k, L_COS]:
+                    spot = max(cos_phi, 0.0) ** lights[k, L_EXP]
+                else:
+                    spot = 0.0
+            scale = shadow[k, i] * f_att * spot
+            ndl = nx * lx + ny * ly + nz * lz
+            lam = max(ndl, 0.0)
+            spec = 0.0
+            if ndl > 0.0 and ks != 0.0:
+                if blinn:
+                    hx, hy, hz = lx + vx, ly + vy, lz + vz
+                    hl = math.sqrt(hx * hx + hy * hy + hz * hz)
+                    if hl > EPS:
+                        spec = _power((nx * hx + ny * hy + nz * hz) / hl, shininess)
+                else:
+                    rx, ry, rz = 2.0 * nx * ndl - lx, 2.0 * ny * ndl - ly, 2.0 * nz * ndl - lz
+                    spec = _power(rx * vx + ry * vy + rz * vz, shininess)
+            for c in range(3):
+                ip = scale * lights[k, L_IP + c]
+                r[c] += ip * kd * mats[m, M_OD + c] * lam + ip * ks * mats[m, M_OS + c] * spec
+        for c in range(3):
+            out[i, c] = r[c]
+    return out
+
+
+@nb.njit(cache=True)
+def surface_frame(origins, dirs, t, tri, u, v, corner_normals, face_normals, object_index):
+    """Hit positions, unit shading and geometric normals facing the ray, entering flags."""
+    n = len(t)
+    position = np.empty((n, 3))
+    normal = np.empty((n, 3))
+    geo = np.empty((n, 3))
+    entering = np.empty(n, np.bool_)
+    obj = np.empty(n, np.int64)
+    for i in range(n):
+        f = tri[i]
+        w0 = 1.0 - u[i] - v[i]
+        side = 0.0
+        for c in range(3):
+            position[i, c] = origins[i, c] + t[i] * dirs[i, c]
+            normal[i, c] = (w0 * corner_normals[f, 0, c] + u[i] * corner_normals[f, 1, c]
+                            + v[i] * corner_normals[f, 2, c])
+            side += face_normals[f, c] * dirs[i, c]
+        length = math.sqrt(normal[i, 0] ** 2 + normal[i, 1] ** 2 + normal[i, 2] ** 2)
+        sign = 1.0 if side < 0.0 else -1.0
+        entering[i] = side < 0.0
+        for c in range(3):
+            normal[i, c] = sign * normal[i, c] / max(length, 1e-300)
+            geo[i, c] = sign * face_normals[f, c]
+        obj[i] = object_index[f]
+    return position, normal, geo, entering, obj
+
+
+@nb.njit(cache=True)
+def shadow_rays(position, geo, lights, k, eps, t_inf):
+    """Origins, directions and tmax of shadow rays to light k, and which points face it."""
+    n = len(position)
+    origins = np.empty((n, 3))
+    dirs = np.empty((n, 3))
+    tmax = np.empty(n)
+    facing = np.empty(n, np.bool_)
+    for i in range(n):
+        lx, ly, lz, dist = _to_light(lights, k, position[i, 0], position[i, 1], position[i, 2])
+        facing[i] = geo[i, 0] * lx + geo[i, 1] * ly + geo[i, 2] * lz > 0.0
+        dirs[i, 0], dirs[i, 1], dirs[i, 2] = lx, ly, lz
+        for c in range(3):
+            origins[i, c] = position[i, c] + eps * geo[i, c]
+        tmax[i] = dist - eps if math.isfinite(dist) else t_inf
+    return origins, dirs, tmax, facing
+
+
+@nb.njit(cache=True)
+def spawn_secondary(position, normal, geo, entering, dirs, mat, weight, pixel, kr, kt, ior,
+                    tint, fresnel, min_weight, eps):
+    """The next generation: reflected and refracted rays whose weight reaches ``min_weight``.
+
+    Mirrors :meth:`TraceContext.secondary` + :func:`reflect_refract` (constant kr/kt with
+    total internal reflection sending kt to reflection, or Fresnel's split of kt).
+    Returns origins, directions, RGB weights and pixel indices of the kept rays.
+    """
+    n = len(dirs)
+    cap = 2 * n
+    out_o = np.empty((cap, 3))
+    out_d = np.empty((cap, 3))
+    out_w = np.empty((cap, 3))
+    out_p = np.empty(cap, np.int64)
+    count = 0
+    threshold = max(min_weight, 1e-12)
+    for i in range(n):
+        m = mat[i]
+        dx, dy, dz = dirs[i, 0], dirs[i, 1], dirs[i, 2]
+        nx, ny, nz = normal[i, 0], normal[i, 1], normal[i, 2]
+        cos_i = min(max(-(dx * nx + dy * ny + dz * nz), 0.0), 1.0)
+        if entering[i]:
+            n1, n2 = 1.0, ior[m]
+        else:
+            n1, n2 = ior[m], 1.0
+        eta = n1 / n2
+        k = 1.0 - eta * eta * (1.0 - cos_i * cos_i)
+        tir = k < 0.0
+        cos_t = math.sqrt(max(k, 0.0))
+        if tir:
+            f = 1.0
+        else:
+            rs = (n1 * cos_i - n2 * cos_t) / max(n1 * cos_i + n2 * cos_t, 1e-300)
+            rp = (n2 * cos_i - n1 * cos_t) / max(n2 * cos_i + n1 * cos_t, 1e-300)
+            f = 0.5 * (rs * rs + rp * rp)
+        if fresnel:
+            refl_s = kr[m] + kt[m] * f
+            refr_s = kt[m] * (1.0 - f)
+        else:
+            refl_s = kr[m] + (kt[m] if tir else 0.0)
+            refr_s = 0.0 if tir else kt[m]
+        # Reflected ray
+        wr0, wr1, wr2 = weight[i, 0] * refl_s, weight[i, 1] * refl_s, weight[i, 2] * refl_s
+        if max(wr0, max(wr1, wr2)) >= threshold:
+            rx, ry, rz = dx + 2.0 * cos_i * nx, dy + 2.0 * cos_i * ny, dz + 2.0 * cos_i * nz
+            length = math.sqrt(rx * rx + ry * ry + rz * rz)
+            out_d[count, 0], out_d[count, 1], out_d[count, 2] = (rx / length, ry / length,
+                                                                 rz / length)
+            for c in range(3):
+                out_o[count, c] = position[i, c] + eps * geo[i, c]
+            out_w[count, 0], out_w[count, 1], out_w[count, 2] = wr0, wr1, wr2
+            out_p[count] = pixel[i]
+            count += 1
+        # Refracted ray
+        wt0 = weight[i, 0] * refr_s * tint[m, 0]
+        wt1 = weight[i, 1] * refr_s * tint[m, 1]
+        wt2 = weight[i, 2] * refr_s * tint[m, 2]
+        if max(wt0, max(wt1, wt2)) >= threshold:
+            a = eta * cos_i - cos_t
+            tx, ty, tz = eta * dx + a * nx, eta * dy + a * ny, eta * dz + a * nz
+            length = math.sqrt(tx * tx + ty * ty + tz * tz)
+            out_d[count, 0], out_d[count, 1], out_d[count, 2] = (tx / length, ty / length,
+                                                                 tz / length)
+            for c in range(3):
+                out_o[count, c] = position[i, c] - eps * geo[i, c]
+            out_w[count, 0], out_w[count, 1], out_w[count, 2] = wt0, wt1, wt2
+            out_p[count] = pixel[i]
+            count += 1
+    return out_o[:count], out_d[:count], out_w[:count], out_p[:count]
+
+
+@nb.njit(cache=True)
+def add_rows(out, pixel, value, mask):
+    """out[pixel[i]] += value[i] where mask[i] (serial: pixels repeat)."""
+    for i in range(len(pixel)):
+        if mask[i]:
+            for c in range(3):
+                out[pixel[i], c] += value[i, c]
+
+
+@nb.njit(cache=True)
+def path_vertex(out, pixel, beta, bsdf_pdf, position, normal, geo, entering, dirs, t, mat,
+                rho, kr, kt, ior, emission, em_cdf, em_p0, em_e1, em_e2, em_normal, em_le,
+                em_area, eps, rnd, roulette):
+    """One path vertex per path: emission (MIS-weighted), next-event set-up, lobe choice.
+
+    Mirrors ``PathTracer`` (see :mod:`shadelab.raytrace.pathtrace` for the estimator). ``rnd``
+    holds 7 uniforms per path: emitter, 2 barycentrics, lobe, 2 direction, roulette.
+    Returns the shadow rays of next-event estimation (origins, dirs, tmax, candidate flag,
+    unoccluded contribution) and the continued paths (origins, dirs, beta, pdf, alive).
+    """
+    n = len(pixel)
+    nee_o = np.empty((n, 3))
+    nee_d = np.empty((n, 3))
+    nee_t = np.empty(n)
+    nee_ok = np.zeros(n, np.bool_)
+    nee_val = np.zeros((n, 3))
+    new_o = np.empty((n, 3))
+    new_d = np.empty((n, 3))
+    new_beta = np.empty((n, 3))
+    new_pdf = np.zeros(n)
+    alive = np.zeros(n, np.bool_)
+    n_em = len(em_cdf)
+    for i in range(n):
+        m = mat[i]
+        px, py, pz = position[i, 0], position[i, 1], position[i, 2]
+        nx, ny, nz = normal[i, 0], normal[i, 1], normal[i, 2]
+        gx, gy, gz = geo[i, 0], geo[i, 1], geo[i, 2]
+        dx, dy, dz = dirs[i, 0], dirs[i, 1], dirs[i, 2]
+        # Emission, MIS-weighted after a diffuse bounce
+        le_max = max(emission[m, 0], max(emission[m, 1], emission[m, 2]))
+        if le_max > 0.0:
+            w = 1.0
+            if bsdf_pdf[i] > 0.0:
+                cos_y = abs(gx * dx + gy * dy + gz * dz)
+                light_pdf = t[i] * t[i] / max(cos_y * em_area, 1e-300)
+                w = bsdf_pdf[i] / (bsdf_pdf[i] + light_pdf)
+            for c in range(3):
+                out[pixel[i], c] += beta[i, c] * emission[m, c] * w
+        p_d = (rho[m, 0] + rho[m, 1] + rho[m, 2]) / 3.0
+        total = p_d + kr[m] + kt[m]
+        prob_d = p_d / total if total > 0.0 else 0.0
+        # Next-event estimation: one point on the emitters, by area
+        if n_em > 0 and p_d > 0.0:
+            k = np.searchsorted(em_cdf, rnd[i, 0], side="right")
+            k = min(k, n_em - 1)
+            s = math.sqrt(rnd[i, 1])
+            a, b = s * (1.0 - rnd[i, 2]), s * rnd[i, 2]
+            qx = em_p0[k, 0] + a * em_e1[k, 0] + b * em_e2[k, 0] - px
+            qy = em_p0[k, 1] + a * em_e1[k, 1] + b * em_e2[k, 1] - py
+            qz = em_p0[k, 2] + a * em_e1[k, 2] + b * em_e2[k, 2] - pz
+            dist = math.sqrt(qx * qx + qy * qy + qz * qz)
+            if dist > 2.0 * eps:
+                wx, wy, wz = qx / dist, qy / dist, qz / dist
+                cos_x = nx * wx + ny * wy + nz * wz
+                cos_y = abs(em_normal[k, 0] * wx + em_normal[k, 1] * wy + em_normal[k, 2] * wz)
+                if cos_x > 0.0 and gx * wx + gy * wy + gz * wz > 0.0:
+                    light_pdf = dist * dist / max(cos_y * em_area, 1e-300)
+                    scale = cos_x / (light_pdf + prob_d * cos_x / math.pi) / math.pi
+                    nee_ok[i] = True
+                    nee_o[i, 0] = px + eps * gx
+                    nee_o[i, 1] = py + eps * gy
+                    nee_o[i, 2] = pz + eps * gz
+                    nee_d[i, 0], nee_d[i, 1], nee_d[i, 2] = wx, wy, wz
+                    nee_t[i] = dist * (1.0 - 1e-4) - 2.0 * eps
+                    for c in range(3):
+                        nee_val[i, c] = beta[i, c] * rho[m, c] * em_le[k, c] * scale
+        if total <= 0.0:
+            continue
+        # Pick a lobe
+        u = rnd[i, 3] * total
+        side = 1.0
+        if u < p_d:  # diffuse: cosine-weighted about the shading normal, weight rho / P
+            r = math.sqrt(rnd[i, 4])
+            phi = 2.0 * math.pi * rnd[i, 5]
+            lx, ly, lz = r * math.cos(phi), r * math.sin(phi), math.sqrt(max(1.0 - rnd[i, 4], 0.0))
+            sign = 1.0 if nz >= 0.0 else -1.0
+            aa = -1.0 / (sign + nz)
+            bb = nx * ny * aa
+            tx, ty, tz = 1.0 + sign * nx * nx * aa, sign * bb, -sign * nx
+            bx, by, bz = bb, sign + ny * ny * aa, -ny
+            ox = lx * tx + ly * bx + lz * nx
+            oy = lx * ty + ly * by + lz * ny
+            oz = lx * tz + ly * bz + lz * nz
+            if ox * gx + oy * gy + oz * gz <= 0.0:
+                continue
+            prob = prob_d
+            for c in range(3):
+                new_beta[i, c] = beta[i, c] * rho[m, c] / prob
+            new_pdf[i] = prob * lz / math.pi
+        else:
+            cos_i = min(max(-(dx * nx + dy * ny + dz * nz), 0.0), 1.0)
+            rx, ry, rz = dx + 2.0 * cos_i * nx, dy + 2.0 * cos_i * ny, dz + 2.0 * cos_i * nz
+            rl = math.sqrt(rx * rx + ry * ry + rz * rz)
+            ox, oy, oz = rx / rl, ry / rl, rz / rl
+            if u < p_d + kr[m]:  # mirror
+                prob = kr[m] / total
+                weight = kr[m]
+            else:  # glass: Fresnel picks reflection or refraction
+                prob = kt[m] / total
+                weight = kt[m]
+                if entering[i]:
+                    n1, n2 = 1.0, ior[m]
+                else:
+                    n1, n2 = ior[m], 1.0
+                eta = n1 / n2
+                kk = 1.0 - eta * eta * (1.0 - cos_i * cos_i)
+                f = 1.0
+                cos_t = 0.0
+                if kk >= 0.0:
+                    cos_t = math.sqrt(kk)
+                    rs = (n1 * cos_i - n2 * cos_t) / max(n1 * cos_i + n2 * cos_t, 1e-300)
+                    rp = (n2 * cos_i - n1 * cos_t) / max(n2 * cos_i + n1 * cos_t, 1e-300)
+                    f = 0.5 * (rs * rs + rp * rp)
+                if rnd[i, 4] >= f:
+                    aa = eta * cos_i - cos_t
+                    tx, ty, tz = eta * dx + aa * nx, eta * dy + aa * ny, eta * dz + aa * nz
+                    tl = math.sqrt(tx * tx + ty * ty + tz * tz)
+                    ox, oy, oz = tx / tl, ty / tl, tz / tl
+                    side = -1.0
+            for c in range(3):
+                new_beta[i, c] = beta[i, c] * weight / prob
+        # Russian roulette
+        if roulette:
+            q = min(max(new_beta[i, 0], max(new_beta[i, 1], new_beta[i, 2])), 0.95)
+            if rnd[i, 6] >= q:
+                continue
+            for c in range(3):
+                new_beta[i, c] /= max(q, 1e-12)
+        alive[i] = True
+        new_d[i, 0], new_d[i, 1], new_d[i, 2] = ox, oy, oz
+        new_o[i, 0] = px + side * eps * gx
+        new_o[i, 1] = py + side * eps * gy
+        new_o[i, 2] = pz + side * eps * gz
+    return nee_o, nee_d, nee_t, nee_ok, nee_val, new_o, new_d, new_beta, new_pdf, alive
+
+
+@nb.njit(cache=True)
+def camera_rays(eye, forward, right, up, tan_half, width, height, r0, r1, jitter):
+    """Rows r0..r1 of :func:`shadelab.scene.camera.primary_rays`, flattened (same formulas);
+    ``jitter`` (r1 - r0, width, 2), or shape (0, 0, 2) for pixel centres."""
+    n = (r1 - r0) * width
+    origins = np.empty((n, 3))
+    dirs = np.empty((n, 3))
+    aspect = width / height
+    centre = jitter.shape[0] == 0
+    for j in range(r0, r1):
+        for i in range(width):
+            k = (j - r0) * width + i
+            jx = 0.5 if centre else jitter[j - r0, i, 0]
+            jy = 0.5 if centre else jitter[j - r0, i, 1]
+            x = (2.0 * ((i + jx) / width) - 1.0) * tan_half * aspect
+            y = (1.0 - 2.0 * ((j + jy) / height)) * tan_half
+            dx = forward[0] + x * right[0] + y * up[0]
+            dy = forward[1] + x * right[1] + y * up[1]
+            dz = forward[2] + x * right[2] + y * up[2]
+            length = math.sqrt(dx * dx + dy * dy + dz * dz)
+            dirs[k, 0], dirs[k, 1], dirs[k, 2] = dx / length, dy / length, dz / length
+            origins[k, 0], origins[k, 1], origins[k, 2] = eye[0], eye[1], eye[2]
+    return origins, dirs
+
+
+@nb.njit(cache=True)
+def add_weighted(out, pixel, weight, value):
+    """out[pixel[i]] += weight[i] * value[i] (RGB)."""
+    for i in range(len(pixel)):
+        for c in range(3):
+            out[pixel[i], c] += weight[i, c] * value[i, c]
+
+
+@nb.njit(cache=True)
+def add_background(out, pixel, weight, hit, background):
+    """out[pixel[i]] += weight[i] * background where the ray missed."""
+    for i in range(len(pixel)):
+        if not hit[i]:
+            for c in range(3):
+                out[pixel[i], c] += weight[i, c] * background[c]

@@ -1,0 +1,258 @@
+"""What every CPU tracer does at a hit: the surface frame, the local model, shadow rays,
+and the mirror and refracted directions with their weights (constant or Fresnel).
+
+Shared by the Whitted tracer, the ray tree and the path tracer so that all three agree.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from shadelab.raytrace import kernels
+from shadelab.raytrace.accel import T_INF, Hits, SceneGeometry, build_accel, scene_geometry
+from shadelab.scene.model import Material, Scene
+from shadelab.shading.reference import light_vectors, shade
+
+
+@dataclass
+class Surface:
+    """N hit points, normals facing the side the ray came from.
+
+    Attributes
+    ----------
+    position : (N, 3) float64, world space
+    normal : (N, 3) float64, unit shading normal (interpolated corner normals)
+    geo_normal : (N, 3) float64, unit geometric normal
+    entering : (N,) bool, the ray hit the front (counter-clockwise) side
+    obj : (N,) int64, object index
+    """
+
+    position: np.ndarray
+    normal: np.ndarray
+    geo_normal: np.ndarray
+    entering: np.ndarray
+    obj: np.ndarray
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.einsum("ij,ij->i", a, b)
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    length = np.linalg.norm(v, axis=-1, keepdims=True)
+    return v / np.maximum(length, 1e-300)
+
+
+class TraceContext:
+    """A scene prepared for CPU tracing: triangles, accelerator, materials, offset.
+
+    Parameters
+    ----------
+    scene : the Scene (read once; rebuild the context after editing geometry)
+    backend : "auto" (Embree where embreex imports), "embree" or "bvh"
+    shadows : False makes every S_i = 1 (no shadow rays), as the raster without volumes
+    offset : ray origin offset as a fraction of the scene diagonal (default: the preset's)
+    local : "numba" (the kernels of :mod:`shadelab.raytrace.kernels`, fast) or "numpy" (calls
+        :func:`shadelab.shading.reference.shade` itself); the two agree to 1e-9 (tested)
+    """
+
+    def __init__(self, scene: Scene, backend: str = "auto", shadows: bool = True,
+                 offset: float | None = None, geometry: SceneGeometry | None = None,
+                 local: str = "numba"):
+        if local not in ("numba", "numpy"):
+            raise ValueError(f"unknown local model implementation {local!r}")
+        self.scene = scene
+        self.kernels = local == "numba"
+        self.geometry = scene_geometry(scene) if geometry is None else geometry
+        self.accel = build_accel(self.geometry, backend)
+        self.lights = scene.active_lights()
+        self.shadows = shadows
+        names = sorted({obj.material for obj in scene.objects})
+        self.material_names = names
+        self.materials: list[Material] = [scene.materials[name] for name in names]
+        self.object_material = np.array([names.index(o.material) for o in scene.objects],
+                                        dtype=np.int64)
+        fraction = scene.raytrace.offset if offset is None else offset
+        self.eps = float(fraction) * self.geometry.diagonal  # world units
+        self.background = np.asarray(scene.render.background, dtype=np.float64)
+        self.specular = scene.render.specular
+        self.shadow_rays = 0  # counter, for rays/s figures
+        self.material_table = kernels.material_table(self.materials)
+        self.light_table = kernels.light_table(self.lights)
+        self.Ia = np.asarray(scene.Ia, dtype=np.float64)
+        mats = self.materials
+        self.kr = np.array([m.mirror for m in mats], dtype=np.float64)
+        self.kt = np.array([m.kt for m in mats], dtype=np.float64)
+        self.ior = np.array([m.ior for m in mats], dtype=np.float64)
+        self.tint = np.array([m.Ot if m.transparency == "filtered" else (1.0, 1.0, 1.0)
+                              for m in mats], dtype=np.float64).reshape(-1, 3)
+
+    # ------------------------------------------------------------ hits
+    def surface(self, origins: np.ndarray, dirs: np.ndarray, hits: Hits) -> Surface:
+        """The surface at each hit (call with hits that all hit something)."""
+        g = self.geometry
+        tri = hits.tri
+        if self.kernels:
+            return Surface(*kernels.surface_frame(
+                np.ascontiguousarray(origins), np.ascontiguousarray(dirs), hits.t, tri,
+                hits.u, hits.v, g.corner_normals, g.face_normals, g.object_index))
+        position = origins + hits.t[:, None] * dirs
+        w0 = 1.0 - hits.u - hits.v
+        corner = g.corner_normals[tri]
+        normal = _unit(w0[:, None] * corner[:, 0] + hits.u[:, None] * corner[:, 1]
+                       + hits.v[:, None] * corner[:, 2])
+        geo = g.face_normals[tri]
+        # Back faces: flip both normals when the geometric face is seen from behind
+        entering = _dot(geo, dirs) < 0.0
+        sign = np.where(entering, 1.0, -1.0)[:, None]
+        return Surface(position, normal * sign, geo * sign, entering, g.object_index[tri])
+
+    def material_ids(self, surf: Surface) -> np.ndarray:
+        return self.object_material[surf.obj]
+
+    # ------------------------------------------------------------ local model
+    def shadow_factors(self, surf: Surface, select: np.ndarray | None = None) -> list[np.ndarray]:
+        """S_i per light for the points ``select`` (all by default): 1 lit, 0 in shadow."""
+        pos = surf.position if select is None else surf.position[select]
+        ng = surf.geo_normal if select is None else surf.geo_normal[select]
+        if self.kernels:
+            return self._shadow_factors_kernel(np.ascontiguousarray(pos),
+                                               np.ascontiguousarray(ng))
+        factors = []
+        for light in self.lights:
+            to_light, distance = light_vectors(light, pos)
+            to_light = np.ascontiguousarray(to_light)
+            if not self.shadows:
+                factors.append(np.ones(len(pos)))
+                continue
+            facing = _dot(ng, to_light) > 0.0
+            s = np.zeros(len(pos))
+            idx = np.flatnonzero(facing)
+            if len(idx):
+                origin = pos[idx] + self.eps * ng[idx]
+                tmax = np.where(np.isfinite(distance[idx]), distance[idx] - self.eps, T_INF)
+                blocked = self.accel.occluded(origin, to_light[idx], tmax)
+                s[idx] = np.where(blocked, 0.0, 1.0)
+                self.shadow_rays += len(idx)
+            factors.append(s)
+        return factors
+
+    def _shadow_factors_kernel(self, pos: np.ndarray, ng: np.ndarray) -> list[np.ndarray]:
+        factors = []
+        for k in range(len(self.lights)):
+            if not self.shadows:
+                factors.append(np.ones(len(pos)))
+                continue
+            origin, dirs, tmax, facing = kernels.shadow_rays(pos, ng, self.light_table, k,
+                                                             self.eps, T_INF)
+            s = np.zeros(len(pos))
+            idx = np.flatnonzero(facing)
+            if len(idx):
+                blocked = self.accel.occluded(origin[idx], dirs[idx], tmax[idx])
+                s[idx] = np.where(blocked, 0.0, 1.0)
+                self.shadow_rays += len(idx)
+            factors.append(s)
+        return factors
+
+    def local(self, surf: Surface, dirs: np.ndarray, shadow: list | None = None) -> np.ndarray:
+        """The lecture's local model at each hit (reference.shade, with shadow-ray S_i)."""
+        out = np.zeros((len(surf.position), 3))
+        if len(out) == 0:
+            return out
+        shadow = self.shadow_factors(surf) if shadow is None else shadow
+        mat = self.material_ids(surf)
+        if self.kernels:
+            s = (np.stack(shadow) if shadow else np.zeros((0, len(out))))
+            return kernels.local_shade(surf.position, surf.normal,
+                                       np.ascontiguousarray(-dirs), mat, self.material_table,
+                                       self.light_table, self.Ia, self.specular == "blinn",
+                                       np.ascontiguousarray(s, dtype=np.float64))
+        for m in np.unique(mat):
+            idx = np.flatnonzero(mat == m)
+            pos = surf.position[idx]
+            out[idx] = shade(pos, surf.normal[idx], pos - dirs[idx], self.materials[m],
+                             self.lights, self.scene.Ia, self.specular,
+                             [s[idx] for s in shadow])
+        return out
+
+    # ------------------------------------------------------------ secondary rays
+    def secondary(self, surf: Surface, dirs: np.ndarray, fresnel: bool):
+        """Mirror and refracted rays: (refl_dir, refl_w, refr_dir, refr_w), weights (N, 3).
+
+        Without Fresnel: reflection kr (``Material.mirror``), refraction kt (times Ot for
+        the filtered transparency model); total internal reflection sends kt to reflection.
+        With Fresnel: the dielectric reflectance F splits kt into kt F (added to kr) and
+        kt (1 - F); a mirror coating kr stays constant.
+        """
+        n = len(dirs)
+        mat = self.material_ids(surf)
+        kr, kt, ior, tint = self.kr[mat], self.kt[mat], self.ior[mat], self.tint[mat]
+        refl_dir, refr_dir, tir, f = reflect_refract(dirs, surf.normal, surf.entering, ior)
+        if fresnel:
+            refl_scalar = kr + kt * f
+            refr_scalar = kt * (1.0 - f)
+        else:
+            refl_scalar = kr + np.where(tir, kt, 0.0)
+            refr_scalar = np.where(tir, 0.0, kt)
+        refl_w = np.repeat(refl_scalar[:, None], 3, axis=1)
+        refr_w = refr_scalar[:, None] * tint
+        return refl_dir, refl_w.reshape(n, 3), refr_dir, refr_w.reshape(n, 3)
+
+    def spawn(self, surf: Surface, dirs: np.ndarray, weight: np.ndarray, pixel: np.ndarray,
+              fresnel: bool, min_weight: float):
+        """The next generation of rays (origins, dirs, weights, pixels) above ``min_weight``."""
+        mat = self.material_ids(surf)
+        if self.kernels:
+            return kernels.spawn_secondary(surf.position, surf.normal, surf.geo_normal,
+                                           surf.entering, np.ascontiguousarray(dirs), mat,
+                                           weight, pixel, self.kr, self.kt, self.ior,
+                                           self.tint, fresnel, min_weight, self.eps)
+        refl_dir, refl_w, refr_dir, refr_w = self.secondary(surf, dirs, fresnel)
+        refl_w, refr_w = weight * refl_w, weight * refr_w
+        keep_r = np.flatnonzero(refl_w.max(axis=1) >= max(min_weight, 1e-12))
+        keep_t = np.flatnonzero(refr_w.max(axis=1) >= max(min_weight, 1e-12))
+        origins = np.concatenate([self.offset_origin(surf, keep_r, True),
+                                  self.offset_origin(surf, keep_t, False)])
+        return (origins, np.concatenate([refl_dir[keep_r], refr_dir[keep_t]]),
+                np.concatenate([refl_w[keep_r], refr_w[keep_t]]),
+                np.concatenate([pixel[keep_r], pixel[keep_t]]))
+
+    def offset_origin(self, surf: Surface, idx: np.ndarray, outward: bool) -> np.ndarray:
+        """Origins moved off the surface by eps, to the incoming side (or through it)."""
+        sign = self.eps if outward else -self.eps
+        return surf.position[idx] + sign * surf.geo_normal[idx]
+
+
+def reflect_refract(dirs: np.ndarray, normal: np.ndarray, entering: np.ndarray,
+                    ior: np.ndarray):
+    """Mirror and Snell directions, total internal reflection and Fresnel reflectance.
+
+    Parameters
+    ----------
+    dirs : (N, 3) unit incident directions (travelling toward the surface)
+    normal : (N, 3) unit normals facing the incident side
+    entering : (N,) bool, going from outside (index 1) into the material (index ``ior``)
+    ior : (N,) the material's index of refraction
+
+    Notes
+    -----
+    R = D - 2 (D . N) N;  eta = n1 / n2;  cos_t^2 = 1 - eta^2 (1 - cos_i^2) (< 0: TIR);
+    T = eta D + (eta cos_i - cos_t) N;  F = (r_s^2 + r_p^2) / 2 with
+    r_s = (n1 cos_i - n2 cos_t) / (n1 cos_i + n2 cos_t), r_p = (n2 cos_i - n1 cos_t) / (...).
+    """
+    cos_i = np.clip(-_dot(dirs, normal), 0.0, 1.0)
+    refl = dirs + 2.0 * cos_i[:, None] * normal
+    n1 = np.where(entering, 1.0, ior)
+    n2 = np.where(entering, ior, 1.0)
+    eta = n1 / n2
+    k = 1.0 - eta * eta * (1.0 - cos_i * cos_i)
+    tir = k < 0.0
+    cos_t = np.sqrt(np.maximum(k, 0.0))
+    refr = eta[:, None] * dirs + (eta * cos_i - cos_t)[:, None] * normal
+    refr = _unit(refr)
+    rs = (n1 * cos_i - n2 * cos_t) / np.maximum(n1 * cos_i + n2 * cos_t, 1e-300)
+    rp = (n2 * cos_i - n1 * cos_t) / np.maximum(n2 * cos_i + n1 * cos_t, 1e-300)
+    f = np.where(tir, 1.0, 0.5 * (rs * rs + rp * rp))
+    return _unit(refl), refr, tir, f

@@ -1,0 +1,129 @@
+"""Raster benchmark: frame time per preset and shading mode, time to first image, and a bare
+moderngl per-fragment Phong draw of the same triangles for a noise-proof ratio."""
+
+from __future__ import annotations
+
+import statistics
+import time
+
+import moderngl
+import numpy as np
+
+from shadelab.bench import median_time
+from shadelab.geometry.mesh import scene_meshes
+from shadelab.gl.context import create_headless_context, headless_context, make_current
+from shadelab.gl.programs import load_program, set_uniform
+from shadelab.gl.target import RenderTarget, release_framebuffer
+from shadelab.render.renderer import Renderer, make_view, triangle_soup
+from shadelab.scene.camera import gl_matrix
+from shadelab.scene.preset import list_presets, load_preset
+
+SIZE = (800, 600)
+
+
+def time_to_first_image() -> float:
+    """Seconds from a new EGL context to the first cornell image read back."""
+    shared = headless_context()
+    start = time.perf_counter()
+    ctx = create_headless_context()
+    renderer = Renderer(ctx)
+    target = RenderTarget(ctx, SIZE)
+    renderer.render(load_preset("cornell"), target)
+    target.read()
+    elapsed = time.perf_counter() - start
+    renderer.release()
+    target.release()
+    ctx.release()
+    make_current(shared)  # the new context was current; give the process's context back
+    return elapsed
+
+
+def bare_phong_frame(ctx: moderngl.Context, preset: str):
+    """The same triangles in one VAO, one light, a plain framebuffer: the floor we compare to.
+
+    Returns ``(frame, release)``: draw one frame (finished), and free the GL objects.
+    """
+    scene = load_preset(preset)
+    meshes = scene_meshes(scene)
+    soup = np.concatenate([triangle_soup(m)[:, :6] for m in meshes]).astype("f4")
+    program = load_program(ctx, "bare_phong")
+    vbo = ctx.buffer(soup.tobytes())
+    vao = ctx.vertex_array(program, [(vbo, "3f 3f", "in_position", "in_normal")])
+    fbo = ctx.framebuffer(ctx.texture(SIZE, 4, dtype="f4"), ctx.depth_renderbuffer(SIZE))
+    view = make_view(scene, SIZE, meshes)
+    set_uniform(program, "u_clip_from_world", gl_matrix(view.clip_from_world))
+    set_uniform(program, "u_eye", tuple(view.eye))
+    set_uniform(program, "u_light_position", tuple(scene.lights[0].position))
+    set_uniform(program, "u_light_Ip", tuple(scene.lights[0].Ip))
+    set_uniform(program, "u_Od", (0.7, 0.7, 0.7))
+    set_uniform(program, "u_ks", 0.0)  # a uniform: the compiler cannot drop the specular term
+    set_uniform(program, "u_n", 10.0)
+
+    def frame():
+        fbo.use()
+        fbo.clear(0.0, 0.0, 0.0, 1.0, depth=1.0)
+        ctx.enable_only(moderngl.DEPTH_TEST)
+        vao.render(moderngl.TRIANGLES)
+        ctx.finish()
+
+    def release():
+        for res in (vao, vbo, program):
+            res.release()
+        release_framebuffer(ctx, fbo)
+
+    return frame, release
+
+
+def interleaved_ratio(ours, bare, repeats: int) -> dict:
+    """Time two frame functions alternately (A B A B ...), so both see the same machine load;
+    the ratio of their medians stays meaningful on a noisy machine."""
+    for _ in range(3):
+        ours()
+        bare()
+    a, b = [], []
+    for _ in range(repeats):
+        for fn, samples in ((ours, a), (bare, b)):
+            start = time.perf_counter()
+            fn()
+            samples.append((time.perf_counter() - start) * 1000.0)
+    return {"ours_median_ms": statistics.median(a), "bare_median_ms": statistics.median(b),
+            "ratio": statistics.median(a) / statistics.median(b),
+            "ratio_of_pairs_median": statistics.median(x / y for x, y in zip(a, b, strict=True)),
+            "repeats": repeats}
+
+
+def run(quick: bool) -> dict:
+    ctx = headless_context()
+    renderer = Renderer(ctx)
+    target = RenderTarget(ctx, SIZE)
+    repeats = 5 if quick else 40
+    frames = {}
+    presets = ["cornell", "sphere-shading"] if quick else list_presets()
+    for name in presets:
+        scene = load_preset(name)
+        for shading in ("flat", "gouraud", "phong"):
+            def frame(scene=scene, shading=shading):
+                renderer.render(scene, target, shading)
+                ctx.finish()
+
+            frames[f"{name}/{shading}"] = median_time(frame, repeats)
+    bare, release_bare = bare_phong_frame(ctx, "cornell")
+    cornell = load_preset("cornell")
+
+    def ours():
+        renderer.render(cornell, target, "phong")
+        ctx.finish()
+
+    paired = interleaved_ratio(ours, bare, 2 * repeats)
+    release_bare()
+    renderer.release()
+    target.release()
+    return {
+        "size": list(SIZE),
+        "frame_ms": frames,
+        "bare_moderngl_phong_cornell": {"median_ms": paired["bare_median_ms"]},
+        "cornell_phong_vs_bare_interleaved": paired,
+        "cornell_phong_over_bare": paired["ratio"],
+        "time_to_first_image_s": time_to_first_image(),
+        "goal": "cornell_phong_over_bare <= 1.3",
+    }

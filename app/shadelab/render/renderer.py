@@ -1,0 +1,387 @@
+"""The raster renderer: a Scene drawn as an ordered list of passes into a RenderTarget.
+
+Geometry lives on the GPU keyed by each object's geometry (:func:`geometry_key`), so a slider
+that changes a coefficient re-sets uniforms only; nothing is re-uploaded.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import moderngl
+import numpy as np
+
+from shadelab.geometry.mesh import MeshData, geometry_key, object_mesh, scene_bounds
+from shadelab.gl.programs import load_program, set_uniform, set_uniform_array
+from shadelab.gl.target import RenderTarget
+from shadelab.render.textures import TextureCache, has_surface_detail
+from shadelab.scene.camera import far_plane, gl_matrix, projection_matrix, view_matrix
+from shadelab.scene.model import MAX_LIGHTS, Light, Material, Scene
+
+SHADING_PROGRAMS = ("flat", "gouraud", "phong")
+# Variants with texture-mapped Od and bump maps (a geometry shader adds the tangents); only
+# materials with a texture or a bump use them, so every other material keeps its output.
+TEXTURED_PROGRAMS = {name: f"{name}_tex" for name in SHADING_PROGRAMS}
+LIGHT_KIND_CODES = {"point": 0, "directional": 1, "spot": 2}
+ATTENUATION_CODES = {"none": 0, "inverse_square": 1, "lecture": 2}
+
+# Interleaved per-corner vertex layout shared by every shading program.
+VERTEX_FORMAT = "3f 3f 3f 3f 2f"
+VERTEX_ATTRIBUTES = ("in_position", "in_normal", "in_face_normal", "in_centroid", "in_uv")
+
+
+@dataclass
+class GpuMesh:
+    """One object's triangle soup on the GPU, with one VAO per shading program."""
+
+    key: tuple
+    mesh: MeshData
+    vbo: moderngl.Buffer
+    vaos: dict[tuple, moderngl.VertexArray]  # keyed by (program name, light signature)
+    bounds: np.ndarray  # (2, 3) min and max corner, world space, computed once at upload
+
+    def release(self) -> None:
+        for vao in self.vaos.values():
+            vao.release()
+        self.vbo.release()
+
+
+def triangle_soup(mesh: MeshData) -> np.ndarray:
+    """(3F, 14) float32: position, corner normal, face normal, centroid, uv per corner."""
+    tri = mesh.triangles
+    faces = len(mesh.faces)
+    centroid = np.repeat(tri.mean(axis=1)[:, None, :], 3, axis=1)
+    face_n = np.repeat(mesh.face_normals[:, None, :], 3, axis=1)
+    uv = mesh.uvs[mesh.faces]
+    soup = np.concatenate([tri, mesh.corner_normals, face_n, centroid, uv], axis=2)
+    return np.ascontiguousarray(soup.reshape(faces * 3, 14), dtype=np.float32)
+
+
+@dataclass
+class View:
+    """Camera matrices for one frame (pyrr row-vector layout)."""
+
+    clip_from_world: np.ndarray
+    eye: np.ndarray
+    size: tuple[int, int]
+
+
+def make_view(scene: Scene, size: tuple[int, int], meshes: list[MeshData],
+              infinite_far: bool = False, bounds: np.ndarray | None = None) -> View:
+    """The scene camera's view for an image of ``size`` = (width, height) pixels.
+
+    ``bounds`` (2, 3), when the caller has them, spares scanning every vertex of ``meshes``.
+    """
+    aspect = size[0] / size[1]
+    if bounds is None:
+        bounds = scene_bounds(meshes)
+    far = math.inf if infinite_far else far_plane(scene.camera, bounds)
+    clip_from_world = view_matrix(scene.camera) @ projection_matrix(scene.camera, aspect, far)
+    return View(clip_from_world, np.asarray(scene.camera.eye, dtype=np.float64), size)
+
+
+class Renderer:
+    """Draws a Scene with flat, Gouraud or Phong shading on any moderngl context."""
+
+    def __init__(self, ctx: moderngl.Context):
+        self.ctx = ctx
+        self._variants: dict[tuple, dict[str, moderngl.Program]] = {}
+        self.light_signature: tuple = ((), "phong")
+        self.programs = self.programs_for_lights([], "phong")
+        self.textures = TextureCache(ctx)
+        self._gpu: dict[int, GpuMesh] = {}
+        self._shadows = None  # shadelab.render.shadows.ShadowVolumes, made on first use
+
+    @staticmethod
+    def light_signature_of(lights: list[Light], specular: str) -> tuple:
+        """What a program variant is compiled for: each light's (kind, attenuation) codes."""
+        codes = tuple((LIGHT_KIND_CODES[light.kind], ATTENUATION_CODES[light.attenuation])
+                      for light in lights[:MAX_LIGHTS])
+        return codes, specular
+
+    @staticmethod
+    def light_defines(signature: tuple) -> dict[str, object]:
+        """The ``#define``s of ``lighting.glsl`` for a light signature (2 bits per light)."""
+        codes, model = signature
+        kinds = sum(kind << (2 * i) for i, (kind, _) in enumerate(codes))
+        attenuations = sum(att << (2 * i) for i, (_, att) in enumerate(codes))
+        return {"NUM_LIGHTS": len(codes), "LIGHT_KINDS": f"{kinds}u",
+                "LIGHT_ATTENUATIONS": f"{attenuations}u",
+                "SPECULAR_MODEL": 1 if model == "blinn" else 0}
+
+    def programs_for_lights(self, lights: list[Light], specular: str) -> dict:
+        """Every shading program compiled for this light configuration (cached).
+
+        Positions, colors and coefficients stay uniforms, so sliders never recompile; adding
+        a light or changing a light's kind or attenuation mode compiles a new variant once.
+        Passes that draw a subset of the lights (the shadow passes) switch the others off with
+        their shadow factor S_i = 0.
+        """
+        signature = self.light_signature_of(lights, specular)
+        if signature not in self._variants:
+            defines = self.light_defines(signature)
+            names = [*SHADING_PROGRAMS, *TEXTURED_PROGRAMS.values()]
+            self._variants[signature] = {name: load_program(self.ctx, name, defines)
+                                         for name in names}
+        return self._variants[signature]
+
+    def use_lights(self, lights: list[Light], specular: str) -> None:
+        """Make ``self.programs`` the variant for these lights (once per frame)."""
+        self.light_signature = self.light_signature_of(lights, specular)
+        self.programs = self.programs_for_lights(lights, specular)
+
+    def vao(self, gpu: GpuMesh, program_name: str) -> moderngl.VertexArray:
+        """The object's VAO for a program of the current light variant (made lazily)."""
+        key = (program_name, self.light_signature)
+        vao = gpu.vaos.get(key)
+        if vao is None:
+            program = self.programs[program_name]
+            layout = [a if a in program else None for a in VERTEX_ATTRIBUTES]
+            vao = self.ctx.vertex_array(program, [(gpu.vbo, _padded_format(layout),
+                                                   *[a for a in layout if a])])
+            gpu.vaos[key] = vao
+        return vao
+
+    # ------------------------------------------------------------ geometry
+    def sync(self, scene: Scene) -> list[GpuMesh]:
+        """Upload objects whose geometry changed; reuse the rest."""
+        live = []
+        for index, obj in enumerate(scene.objects):
+            key = geometry_key(obj, scene.base_dir)
+            gpu = self._gpu.get(index)
+            if gpu is None or gpu.key != key:
+                if gpu is not None:
+                    gpu.release()
+                gpu = self._upload(key, object_mesh(obj, index, scene.base_dir))
+                self._gpu[index] = gpu
+            gpu.mesh.material = obj.material
+            live.append(gpu)
+        for index in [i for i in self._gpu if i >= len(scene.objects)]:
+            self._gpu.pop(index).release()
+        return live
+
+    def _upload(self, key: tuple, mesh: MeshData) -> GpuMesh:
+        vbo = self.ctx.buffer(triangle_soup(mesh).tobytes())
+        bounds = np.stack([mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)])
+        return GpuMesh(key, mesh, vbo, {}, bounds)  # VAOs: per program variant, lazily
+
+    # ------------------------------------------------------------ uniforms
+    def variants(self, shading: str) -> list[moderngl.Program]:
+        """The shading mode's program and its surface-detail variant."""
+        return [self.programs[shading], self.programs[TEXTURED_PROGRAMS[shading]]]
+
+    def program_for(self, shading: str, material: Material) -> str:
+        """Name of the program that draws ``material`` in ``shading`` mode."""
+        return TEXTURED_PROGRAMS[shading] if has_surface_detail(material) else shading
+
+    def use_material(self, scene: Scene, name: str, shading: str) -> str:
+        """Set one material's uniforms (and textures) on its program; returns the program name."""
+        material = scene.materials[name]
+        program_name = self.program_for(shading, material)
+        program = self.programs[program_name]
+        self.set_material_uniforms(program, material)
+        if program_name != shading:
+            self.textures.bind(program, name, material, scene.base_dir)
+        return program_name
+
+    def set_frame_uniforms(self, program: moderngl.Program, scene: Scene, view: View,
+                           specular: str) -> None:
+        set_uniform(program, "u_clip_from_world", gl_matrix(view.clip_from_world))
+        set_uniform(program, "u_eye", tuple(view.eye))
+        set_uniform(program, "u_Ia", tuple(scene.Ia))
+        set_uniform(program, "u_specular_model", 1 if specular == "blinn" else 0)
+        write_light_uniforms(program, scene.active_lights())
+
+    @staticmethod
+    def set_material_uniforms(program: moderngl.Program, material: Material) -> None:
+        for name in ("ka", "kd", "ks", "n"):
+            set_uniform(program, f"u_{name}", float(getattr(material, name)))
+        set_uniform(program, "u_Od", tuple(material.Od))
+        set_uniform(program, "u_Os", tuple(material.Os))
+        set_uniform(program, "u_emission", tuple(material.emission))
+
+    # ------------------------------------------------------------ passes
+    def render(self, scene: Scene, target: RenderTarget, shading: str | None = None,
+               specular: str | None = None) -> View:
+        """Draw one frame into ``target``; returns the view used."""
+        shading = shading or scene.render.shading
+        specular = specular or scene.render.specular
+        settings = scene.render
+        gpu_meshes = self.sync(scene)
+        lights = scene.active_lights()[:MAX_LIGHTS]
+        self.use_lights(lights, specular)
+        painter = settings.visibility == "painter"
+        shadowed = settings.shadows == "volumes" and bool(lights) and not painter
+        # Shadow volumes reach infinity (w = 0): the whole frame then uses an infinite far plane.
+        view = make_view(scene, target.size, [g.mesh for g in gpu_meshes], infinite_far=shadowed,
+                         bounds=_union_bounds([g.bounds for g in gpu_meshes]))
+        opaque = [g for g in gpu_meshes if not is_transparent(scene.materials[g.mesh.material])]
+        clear = [g for g in gpu_meshes if is_transparent(scene.materials[g.mesh.material])]
+        # --- PASS 1: clear color, depth and stencil
+        target.clear(settings.background)
+        if painter:
+            # --- PASS 2 (list priority): every triangle back to front, no depth test
+            from shadelab.render.painter import draw_painter
+
+            for variant in self.variants(shading):
+                self.set_frame_uniforms(variant, scene, view, specular)
+                set_uniform(variant, "u_ambient_on", 1.0)
+            draw_painter(self, scene, gpu_meshes, shading, view)
+            return view
+        # --- PASS 2: opaque surfaces, ambient + every light in one pass (S_i = 1);
+        #     with shadow volumes: ambient + emission only (the lights come in pass 3)
+        self.ctx.enable_only(moderngl.DEPTH_TEST)
+        if shadowed:
+            self.use_lights([], specular)  # programs with no light loop: ambient + Le only
+        for variant in self.variants(shading):
+            self.set_frame_uniforms(variant, scene, view, specular)
+            set_uniform(variant, "u_ambient_on", 1.0)
+        self.draw_objects(scene, opaque, shading)
+        if shadowed:
+            self.use_lights(lights, specular)
+            for variant in self.variants(shading):
+                self.set_frame_uniforms(variant, scene, view, specular)
+        # --- PASS 3: per light, a stencil count of its shadow volumes (z-fail or z-pass),
+        #     then that light alone added where the count is 0 (S_i = 1), nowhere else
+        if shadowed:
+            self._shadow_passes(scene, target, view, gpu_meshes, opaque, lights, shading)
+        # --- PASS 4: transparent surfaces back to front, blended by their model
+        #     (interpolated or filtered), depth-tested against the opaque ones
+        if clear:
+            from shadelab.render.transparency import draw_transparent
+
+            for variant in self.variants(shading):
+                self.set_frame_uniforms(variant, scene, view, specular)
+                set_uniform(variant, "u_ambient_on", 1.0)
+            draw_transparent(self, scene, clear, shading, view)
+        # --- PASS 5: teaching overlays: stencil heat map, translucent volumes, silhouettes
+        if shadowed and (settings.stencil_heatmap or settings.show_volumes
+                         or settings.show_silhouettes):
+            self._shadow_overlays(scene, target, view, gpu_meshes, lights)
+        self.ctx.enable_only(moderngl.DEPTH_TEST)
+        return view
+
+    @property
+    def shadow_volumes(self):
+        """The stencil shadow-volume helper (made on first use)."""
+        if self._shadows is None:
+            from shadelab.render.shadows import ShadowVolumes
+
+            self._shadows = ShadowVolumes(self.ctx)
+        return self._shadows
+
+    def _shadow_passes(self, scene: Scene, target: RenderTarget, view: View, gpu_meshes,
+                       opaque, lights: list[Light], shading: str) -> None:
+        shadows = self.shadow_volumes
+        shadows.drop_lights_from(len(lights))
+        for variant in self.variants(shading):
+            set_uniform(variant, "u_ambient_on", 0.0)
+        for index, light in enumerate(lights):
+            volumes = shadows.volumes(scene, gpu_meshes, index, light)
+            shadows.count(target, view, volumes, scene.render.shadow_method)
+            self.ctx.enable_only(moderngl.DEPTH_TEST | moderngl.BLEND)
+            self.ctx.blend_func = moderngl.ONE, moderngl.ONE
+            self.ctx.depth_func = "<="
+            shadows.lit_where_zero()
+            for variant in self.variants(shading):
+                write_light_uniforms(variant, lights,
+                                     shadow=[float(j == index) for j in range(len(lights))])
+            self.draw_objects(scene, opaque, shading)
+        shadows.stencil_off()
+        self.ctx.depth_func = "<"
+        self.ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA  # the default
+        target.fbo.depth_mask = True
+        target.fbo.use()
+        for variant in self.variants(shading):
+            write_light_uniforms(variant, lights)
+            set_uniform(variant, "u_ambient_on", 1.0)
+
+    def _shadow_overlays(self, scene: Scene, target: RenderTarget, view: View, gpu_meshes,
+                         lights: list[Light]) -> None:
+        shadows = self.shadow_volumes
+        settings = scene.render
+        index = min(settings.heatmap_light, len(lights) - 1)
+        volumes = shadows.volumes(scene, gpu_meshes, index, lights[index])
+        if settings.stencil_heatmap:
+            shadows.count(target, view, volumes, settings.shadow_method)
+            shadows.heatmap()
+        if settings.show_volumes:
+            for i, light in enumerate(lights):
+                shadows.draw_translucent(view, shadows.volumes(scene, gpu_meshes, i, light))
+        if settings.show_silhouettes:
+            for i, light in enumerate(lights):
+                shadows.draw_silhouettes(view, shadows.volumes(scene, gpu_meshes, i, light))
+        target.fbo.depth_mask = True
+        target.fbo.use()
+
+    def draw_objects(self, scene: Scene, gpu_meshes: list[GpuMesh], shading: str) -> None:
+        for gpu in gpu_meshes:
+            program_name = self.use_material(scene, gpu.mesh.material, shading)
+            self.vao(gpu, program_name).render(moderngl.TRIANGLES)
+
+    def release(self) -> None:
+        for gpu in self._gpu.values():
+            gpu.release()
+        self._gpu.clear()
+        for variant in self._variants.values():
+            for program in variant.values():
+                program.release()
+        self._variants.clear()
+        if self._shadows is not None:
+            self._shadows.release()
+            self._shadows = None
+        self.textures.release()
+
+
+def _union_bounds(boxes: list[np.ndarray]) -> np.ndarray | None:
+    """The box around per-object (2, 3) boxes; None for an empty scene (make_view's default)."""
+    if not boxes:
+        return None
+    stacked = np.stack(boxes)
+    return np.stack([stacked[:, 0].min(axis=0), stacked[:, 1].max(axis=0)])
+
+
+def is_transparent(material: Material) -> bool:
+    """Drawn in the blended pass: the lecture's transmission coefficient kt is above 0."""
+    return material.kt > 0.0
+
+
+def _padded_format(layout: list[str | None]) -> str:
+    """Buffer format with unused attributes skipped as padding (``12x`` / ``8x``)."""
+    parts = []
+    for fmt, name in zip(VERTEX_FORMAT.split(), layout, strict=True):
+        count = int(fmt[0])
+        parts.append(fmt if name else f"{count * 4}x")
+    return " ".join(parts)
+
+
+def write_light_uniforms(program: moderngl.Program, lights: list[Light],
+                         shadow: list[float] | None = None) -> None:
+    """Fill the ``u_light_*`` arrays of ``lighting.glsl`` (padded to MAX_LIGHTS)."""
+    count = min(len(lights), MAX_LIGHTS)
+    kinds = np.zeros(MAX_LIGHTS, np.int32)
+    att = np.zeros(MAX_LIGHTS, np.int32)
+    pos = np.zeros((MAX_LIGHTS, 3), np.float32)
+    direction = np.zeros((MAX_LIGHTS, 3), np.float32)
+    ip = np.zeros((MAX_LIGHTS, 3), np.float32)
+    c = np.zeros((MAX_LIGHTS, 3), np.float32)
+    spot = np.zeros((MAX_LIGHTS, 2), np.float32)
+    s = np.ones(MAX_LIGHTS, np.float32)
+    for i, light in enumerate(lights[:count]):
+        kinds[i] = LIGHT_KIND_CODES[light.kind]
+        att[i] = ATTENUATION_CODES[light.attenuation]
+        pos[i] = light.position
+        d = np.asarray(light.direction, dtype=np.float64)
+        direction[i] = d / max(np.linalg.norm(d), 1e-30)
+        ip[i] = light.Ip
+        c[i] = (light.c1, light.c2, light.c3)
+        spot[i] = (math.cos(math.radians(light.cone_angle)), light.spot_exponent)
+        if shadow is not None:
+            s[i] = shadow[i]
+    set_uniform(program, "u_num_lights", count)
+    for name, array in (("u_light_kind", kinds), ("u_light_attenuation", att),
+                        ("u_light_position", pos), ("u_light_direction", direction),
+                        ("u_light_Ip", ip), ("u_light_c", c), ("u_light_spot", spot),
+                        ("u_light_S", s)):
+        set_uniform_array(program, name, array)

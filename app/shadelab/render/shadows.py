@@ -1,0 +1,242 @@
+"""Stencil shadow volumes on moderngl (the GL side; geometry in shadelab/geometry/silhouette.py).
+
+Per light: clear the stencil, draw every caster's volume with color and depth writes off and
+two-sided stencil counting, then draw that light's contribution additively where the count is
+zero. z-fail (Carmack's reverse) counts volume faces *behind* the visible surface (back faces
++1, front faces -1) and is robust with the eye inside a volume, given far caps at infinity
+(w = 0, infinite far plane, depth clamp on). z-pass counts faces *in front* (front +1, back -1)
+and breaks when the eye sits inside a volume: it is here to show that failure.
+
+moderngl has no stencil API: stencil state goes through PyOpenGL (DESIGN.md section 4).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import moderngl
+import numpy as np
+
+from shadelab.geometry.mesh import scene_bounds
+from shadelab.geometry.silhouette import ShadowVolume, light_homogeneous, shadow_volume
+from shadelab.gl.programs import load_program, set_uniform
+from shadelab.scene.camera import gl_matrix
+from shadelab.scene.model import Light, Scene
+
+OFFSET_FRACTION = 1e-3  # volumes start this share of the scene's diagonal beyond the caster
+VOLUME_COLOR = (0.25, 0.45, 1.0, 0.18)  # translucent volumes (linear RGB, alpha)
+SILHOUETTE_COLOR = (1.0, 0.85, 0.1, 1.0)
+HEAT_LEVELS = 8  # stencil counts 1..8 get their own color; above 8 shows as 8
+
+
+def _gl():
+    from OpenGL import GL
+
+    return GL
+
+
+def heat_color(count: int) -> tuple[float, float, float, float]:
+    """Heat-map color of a stencil count (1 = blue ... 8 = red), half transparent."""
+    t = (min(count, HEAT_LEVELS) - 1) / (HEAT_LEVELS - 1)
+    return (t, 1.0 - abs(2.0 * t - 1.0), 1.0 - t, 0.6)
+
+
+def light_key(light: Light) -> tuple:
+    return (light.kind, tuple(light.position), tuple(light.direction))
+
+
+@dataclass
+class CasterVolume:
+    """One caster's volume for one light, on the GPU."""
+
+    key: tuple
+    volume: ShadowVolume
+    vbo: moderngl.Buffer
+    vao: moderngl.VertexArray
+    line_vbo: moderngl.Buffer
+    line_vao: moderngl.VertexArray
+
+    def release(self) -> None:
+        for item in (self.vao, self.vbo, self.line_vao, self.line_vbo):
+            item.release()
+
+
+class ShadowVolumes:
+    """Builds (and caches) shadow-volume geometry and runs the stencil passes."""
+
+    def __init__(self, ctx: moderngl.Context):
+        self.ctx = ctx
+        self.program = load_program(ctx, "shadow_volume")
+        self._cache: dict[tuple[int, int], CasterVolume] = {}
+        quad = np.array([[-1, -1, 1, 1], [1, -1, 1, 1], [1, 1, 1, 1],
+                         [-1, -1, 1, 1], [1, 1, 1, 1], [-1, 1, 1, 1]], dtype=np.float32)
+        self._quad_vbo = ctx.buffer(quad.tobytes())
+        self._quad_vao = ctx.vertex_array(self.program, [(self._quad_vbo, "4f", "in_position")])
+
+    # ------------------------------------------------------------ geometry
+    def volumes(self, scene: Scene, gpu_meshes, light_index: int,
+                light: Light) -> list[CasterVolume]:
+        """The volumes of every shadow-casting object for one light (cached)."""
+        offset = OFFSET_FRACTION * float(np.linalg.norm(np.ptp(
+            scene_bounds([g.mesh for g in gpu_meshes]), axis=0)))
+        homogeneous = light_homogeneous(light.kind, light.position, light.direction)
+        out = []
+        live = set()
+        for gpu in gpu_meshes:
+            obj = scene.objects[gpu.mesh.index] if gpu.mesh.index < len(scene.objects) else None
+            if obj is None or not obj.cast_shadows:
+                continue
+            slot = (gpu.mesh.index, light_index)
+            key = (gpu.key, light_key(light), offset)
+            live.add(slot)
+            cached = self._cache.get(slot)
+            if cached is None or cached.key != key:
+                if cached is not None:
+                    cached.release()
+                cached = self._upload(key, shadow_volume(gpu.mesh.vertices, gpu.mesh.faces,
+                                                         homogeneous, offset))
+                self._cache[slot] = cached
+            out.append(cached)
+        for slot in [s for s in self._cache if s[1] == light_index and s not in live]:
+            self._cache.pop(slot).release()
+        return out
+
+    def _upload(self, key: tuple, volume: ShadowVolume) -> CasterVolume:
+        vbo = self.ctx.buffer(volume.triangles().tobytes())
+        vao = self.ctx.vertex_array(self.program, [(vbo, "4f", "in_position")])
+        lines = volume.vertices[volume.silhouette].astype(np.float32)
+        line_vbo = self.ctx.buffer(lines.tobytes() if len(lines) else bytes(32))
+        line_vao = self.ctx.vertex_array(self.program, [(line_vbo, "4f", "in_position")])
+        return CasterVolume(key, volume, vbo, vao, line_vbo, line_vao)
+
+    def drop_lights_from(self, count: int) -> None:
+        for slot in [s for s in self._cache if s[1] >= count]:
+            self._cache.pop(slot).release()
+
+    # ------------------------------------------------------------ passes
+    def count(self, target, view, volumes: list[CasterVolume], method: str) -> None:
+        """Stencil pass: clear the stencil and count volume faces (z-fail or z-pass)."""
+        GL = _gl()
+        ctx = self.ctx
+        _ = ctx.error
+        target.fbo.color_mask = (False, False, False, False)
+        target.fbo.depth_mask = False
+        target.fbo.use()  # applies the masks (moderngl sets them on use)
+        _ = ctx.error
+        GL.glStencilMask(0xFF)
+        GL.glClearStencil(0)
+        GL.glClear(GL.GL_STENCIL_BUFFER_BIT)
+        ctx.enable_only(moderngl.DEPTH_TEST)
+        ctx.depth_func = "<"
+        GL.glEnable(GL.GL_STENCIL_TEST)
+        if method == "zfail":  # far caps at w = 0 may round past depth 1: clamp, never clip
+            GL.glEnable(GL.GL_DEPTH_CLAMP)
+        GL.glStencilFunc(GL.GL_ALWAYS, 0, 0xFF)
+        if method == "zpass":
+            GL.glStencilOpSeparate(GL.GL_FRONT, GL.GL_KEEP, GL.GL_KEEP, GL.GL_INCR_WRAP)
+            GL.glStencilOpSeparate(GL.GL_BACK, GL.GL_KEEP, GL.GL_KEEP, GL.GL_DECR_WRAP)
+        else:
+            GL.glStencilOpSeparate(GL.GL_BACK, GL.GL_KEEP, GL.GL_INCR_WRAP, GL.GL_KEEP)
+            GL.glStencilOpSeparate(GL.GL_FRONT, GL.GL_KEEP, GL.GL_DECR_WRAP, GL.GL_KEEP)
+        set_uniform(self.program, "u_clip_from_world", gl_matrix(view.clip_from_world))
+        set_uniform(self.program, "u_color", (0.0, 0.0, 0.0, 0.0))
+        for caster in volumes:
+            caster.vao.render(moderngl.TRIANGLES)
+        GL.glDisable(GL.GL_DEPTH_CLAMP)
+        GL.glStencilOp(GL.GL_KEEP, GL.GL_KEEP, GL.GL_KEEP)
+        target.fbo.color_mask = (True, True, True, True)
+        target.fbo.use()  # color writes back on; depth writes stay off until the frame ends
+
+    def lit_where_zero(self) -> None:
+        """Stencil state for the additive lit pass: draw only where the count is 0."""
+        GL = _gl()
+        _ = self.ctx.error
+        GL.glEnable(GL.GL_STENCIL_TEST)
+        GL.glStencilMask(0x00)
+        GL.glStencilFunc(GL.GL_EQUAL, 0, 0xFF)
+        GL.glStencilOp(GL.GL_KEEP, GL.GL_KEEP, GL.GL_KEEP)
+
+    def stencil_off(self) -> None:
+        GL = _gl()
+        _ = self.ctx.error
+        GL.glDisable(GL.GL_STENCIL_TEST)
+        GL.glStencilMask(0xFF)
+
+    # ------------------------------------------------------------ teaching overlays
+    def heatmap(self) -> None:
+        """Blend a heat-map color over every covered pixel by its current stencil count
+        (depth writes are still off from :meth:`count`)."""
+        GL = _gl()
+        ctx = self.ctx
+        ctx.enable_only(moderngl.BLEND)
+        ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
+        _ = ctx.error
+        GL.glEnable(GL.GL_STENCIL_TEST)
+        GL.glStencilMask(0x00)
+        GL.glStencilOp(GL.GL_KEEP, GL.GL_KEEP, GL.GL_KEEP)
+        ctx.enable(moderngl.DEPTH_TEST)  # the quad sits at depth 1: only covered pixels pass
+        ctx.depth_func = ">"
+        identity = np.eye(4, dtype=np.float32).tobytes()
+        set_uniform(self.program, "u_clip_from_world", identity)
+        for level in range(1, HEAT_LEVELS + 1):
+            if level < HEAT_LEVELS:
+                GL.glStencilFunc(GL.GL_EQUAL, level, 0xFF)
+            else:  # 8 and above (a count of -1 wraps to 255 and shows here too)
+                GL.glStencilFunc(GL.GL_LEQUAL, level, 0xFF)
+            set_uniform(self.program, "u_color", heat_color(level))
+            self._quad_vao.render(moderngl.TRIANGLES)
+        ctx.depth_func = "<"
+        self.stencil_off()
+
+    def draw_translucent(self, view, volumes: list[CasterVolume]) -> None:
+        """Draw the volumes themselves, translucent, depth-tested against the scene."""
+        GL = _gl()
+        ctx = self.ctx
+        ctx.enable_only(moderngl.DEPTH_TEST | moderngl.BLEND)
+        ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
+        _ = ctx.error
+        GL.glDisable(GL.GL_STENCIL_TEST)
+        GL.glEnable(GL.GL_DEPTH_CLAMP)
+        set_uniform(self.program, "u_clip_from_world", gl_matrix(view.clip_from_world))
+        set_uniform(self.program, "u_color", VOLUME_COLOR)
+        for caster in volumes:
+            caster.vao.render(moderngl.TRIANGLES)
+        GL.glDisable(GL.GL_DEPTH_CLAMP)
+
+    def draw_silhouettes(self, view, volumes: list[CasterVolume]) -> None:
+        """Silhouette edges as lines, on top of everything."""
+        ctx = self.ctx
+        ctx.enable_only(moderngl.NOTHING)
+        _ = ctx.error
+        _gl().glDisable(_gl().GL_STENCIL_TEST)
+        set_uniform(self.program, "u_clip_from_world", gl_matrix(view.clip_from_world))
+        set_uniform(self.program, "u_color", SILHOUETTE_COLOR)
+        for caster in volumes:
+            if len(caster.volume.silhouette):  # open casters: their contour edges
+                caster.line_vao.render(moderngl.LINES)
+
+    def release(self) -> None:
+        for caster in self._cache.values():
+            caster.release()
+        self._cache.clear()
+        self._quad_vao.release()
+        self._quad_vbo.release()
+        self.program.release()
+
+
+def shadow_masks(renderer, scene: Scene, target, shading: str | None = None) -> np.ndarray:
+    """(L, H, W) bool, row 0 at the top: True where light i's stencil count is non-zero
+    (S_i = 0) on the frame just drawn. For tests and the viewer's inspection."""
+    view = renderer.render(scene, target, shading)
+    lights = scene.active_lights()
+    gpu_meshes = renderer.sync(scene)
+    shadows = renderer.shadow_volumes
+    masks = []
+    for index, light in enumerate(lights):
+        shadows.count(target, view, shadows.volumes(scene, gpu_meshes, index, light),
+                      scene.render.shadow_method)
+        masks.append(target.read_stencil() != 0)
+    shadows.stencil_off()
+    target.fbo.depth_mask = True
+    target.fbo.use()
+    return np.array(masks).reshape(len(lights), target.size[1], target.size[0])

@@ -1,0 +1,95 @@
+"""Surface detail for the raster renderer: texture-mapped Od and bump maps, per material.
+
+``Material.texture`` is ``""`` (none), ``"checker"`` (procedural: Od and texture_color2) or an
+image path; ``Material.bump`` is ``""``, ``"bumps"`` (procedural sine bumps) or a height-map
+image path (gray levels, 0 = low, white = high). Paths are relative to the preset's folder.
+Color images are sRGB-encoded files and are decoded to linear RGB; height maps are used as
+stored. ``texture_scale`` repeats both patterns across [0, 1] uv. The GLSL side is
+``shaders/include/surface.glsl`` and the ``*_tex`` programs, used only by materials with a
+texture or a bump, so every other material keeps its exact output.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import moderngl
+import numpy as np
+from PIL import Image, UnidentifiedImageError
+
+from shadelab.errors import ShadeLabError
+from shadelab.gl.programs import set_uniform
+from shadelab.scene.model import Material
+
+TEXTURE_MODES = {"": 0, "checker": 1}  # anything else: an image file (mode 2)
+BUMP_MODES = {"": 0, "bumps": 1}
+
+
+def has_surface_detail(material: Material) -> bool:
+    return bool(material.texture) or bool(material.bump)
+
+
+def _resolve(path: str, base_dir: str, key: str) -> Path:
+    full = Path(path) if Path(path).is_absolute() else Path(base_dir) / path
+    if not full.is_file():
+        raise ShadeLabError(f"{key}: image file '{full}' not found")
+    return full
+
+
+def srgb_to_linear(c: np.ndarray) -> np.ndarray:
+    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+
+
+def load_image(path: str, base_dir: str, key: str, height: bool = False) -> np.ndarray:
+    """(H, W, 3) linear RGB or (H, W) height in [0, 1], float32, row 0 at the BOTTOM (GL's v)."""
+    full = _resolve(path, base_dir, key)
+    try:
+        with Image.open(full) as image:
+            pixels = np.asarray(image.convert("L" if height else "RGB"), dtype=np.float32)
+    except (UnidentifiedImageError, OSError) as exc:
+        raise ShadeLabError(f"{key}: '{full.name}' could not be read as an image ({exc})") from None
+    pixels = pixels[::-1] / 255.0
+    if not height:
+        pixels = srgb_to_linear(pixels)
+    return np.ascontiguousarray(pixels, dtype=np.float32)
+
+
+class TextureCache:
+    """GPU textures for image files, keyed by resolved path and kind; made on first use."""
+
+    def __init__(self, ctx: moderngl.Context):
+        self.ctx = ctx
+        self._textures: dict[tuple[str, str, bool], moderngl.Texture] = {}
+
+    def get(self, path: str, base_dir: str, key: str, height: bool) -> moderngl.Texture:
+        slot = (path, base_dir, height)
+        if slot not in self._textures:
+            pixels = load_image(path, base_dir, key, height)
+            h, w = pixels.shape[:2]
+            texture = self.ctx.texture((w, h), 1 if height else 3, pixels.tobytes(), dtype="f4")
+            texture.repeat_x = texture.repeat_y = True
+            texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
+            self._textures[slot] = texture
+        return self._textures[slot]
+
+    def bind(self, program: moderngl.Program, name: str, material: Material,
+             base_dir: str) -> None:
+        """Set the surface uniforms of one material and bind its images (units 0 and 1)."""
+        texture_mode = TEXTURE_MODES.get(material.texture, 2)
+        bump_mode = BUMP_MODES.get(material.bump, 2)
+        set_uniform(program, "u_texture_mode", texture_mode)
+        set_uniform(program, "u_texture_scale", float(material.texture_scale))
+        set_uniform(program, "u_texture_color2", tuple(material.texture_color2))
+        set_uniform(program, "u_bump_mode", bump_mode)
+        set_uniform(program, "u_bump_scale", float(material.bump_scale))
+        set_uniform(program, "u_texture", 0)
+        set_uniform(program, "u_bump_map", 1)
+        if texture_mode == 2:
+            self.get(material.texture, base_dir, f"materials.{name}.texture", False).use(0)
+        if bump_mode == 2:
+            self.get(material.bump, base_dir, f"materials.{name}.bump", True).use(1)
+
+    def release(self) -> None:
+        for texture in self._textures.values():
+            texture.release()
+        self._textures.clear()

@@ -1,0 +1,82 @@
+"""Camera math shared by every renderer, so raster, ray-traced and radiosity images align.
+
+Matrices follow pyrr's row-vector convention (``p_clip = p_world @ clip_from_world``);
+:func:`gl_matrix` gives the column-major bytes GLSL expects.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from pyrr import Matrix44
+
+from shadelab.scene.model import Camera
+
+
+def camera_basis(camera: Camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Unit forward, right and up vectors of the camera, world space."""
+    eye = np.asarray(camera.eye, dtype=np.float64)
+    forward = np.asarray(camera.target, dtype=np.float64) - eye
+    forward /= np.linalg.norm(forward)
+    right = np.cross(forward, np.asarray(camera.up, dtype=np.float64))
+    if np.linalg.norm(right) < 1e-12:  # up parallel to the view: pick any perpendicular
+        right = np.cross(forward, [1.0, 0.0, 0.0] if abs(forward[0]) < 0.9 else [0.0, 0.0, 1.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    return forward, right, up
+
+
+def view_matrix(camera: Camera) -> np.ndarray:
+    """``view_from_world`` as a pyrr (row-vector) 4x4 float64 matrix."""
+    forward, _, up = camera_basis(camera)
+    eye = np.asarray(camera.eye, dtype=np.float64)
+    return np.asarray(Matrix44.look_at(eye, eye + forward, up), dtype=np.float64)
+
+
+def projection_matrix(camera: Camera, aspect: float, far: float) -> np.ndarray:
+    """``clip_from_view``: a perspective with the camera's vertical fov; ``far`` may be inf."""
+    if math.isinf(far):
+        f = 1.0 / math.tan(math.radians(camera.fov_y) / 2.0)
+        near = camera.near
+        # Infinite far plane (Everitt & Kilgard 2002), row-vector layout like pyrr's.
+        return np.array([[f / aspect, 0, 0, 0],
+                         [0, f, 0, 0],
+                         [0, 0, -1.0, -1.0],
+                         [0, 0, -2.0 * near, 0]], dtype=np.float64)
+    return np.asarray(Matrix44.perspective_projection(camera.fov_y, aspect, camera.near, far),
+                      dtype=np.float64)
+
+
+def far_plane(camera: Camera, bounds: np.ndarray) -> float:
+    """A far plane just behind the farthest corner of the scene's (2, 3) bounds."""
+    corners = np.array([[bounds[i][0], bounds[j][1], bounds[k][2]]
+                        for i in (0, 1) for j in (0, 1) for k in (0, 1)])
+    distance = np.linalg.norm(corners - np.asarray(camera.eye), axis=1).max()
+    return float(max(distance * 1.5, camera.near * 10.0))
+
+
+def gl_matrix(matrix: np.ndarray) -> bytes:
+    """Bytes of a pyrr matrix as a GLSL ``mat4`` uniform (float32, column-major)."""
+    return np.ascontiguousarray(matrix, dtype=np.float32).tobytes()
+
+
+def primary_rays(camera: Camera, width: int, height: int,
+                 jitter: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Origins and unit directions (height, width, 3) through pixel centres, row 0 at the top.
+
+    ``jitter`` (height, width, 2) in [0, 1) moves the sample inside the pixel (stratified
+    anti-aliasing); without it the ray passes through the centre, as the rasterizer samples.
+    """
+    forward, right, up = camera_basis(camera)
+    tan_half = math.tan(math.radians(camera.fov_y) / 2.0)
+    aspect = width / height
+    offset = np.full((height, width, 2), 0.5) if jitter is None else jitter
+    cols = (np.arange(width)[None, :] + offset[..., 0]) / width
+    rows = (np.arange(height)[:, None] + offset[..., 1]) / height
+    x = (2.0 * cols - 1.0) * tan_half * aspect
+    y = (1.0 - 2.0 * rows) * tan_half
+    directions = forward + x[..., None] * right + y[..., None] * up
+    directions /= np.linalg.norm(directions, axis=-1, keepdims=True)
+    origins = np.broadcast_to(np.asarray(camera.eye, dtype=np.float64), directions.shape).copy()
+    return origins, directions

@@ -1,0 +1,340 @@
+"""TOML presets: load, validate, override with ``--set``, save (round-trips exactly).
+
+Every error is a :class:`ShadeLabError` whose one line names the file, the key (or line)
+and what was expected.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import math
+import tomllib
+from pathlib import Path
+from typing import Any
+
+import tomli_w
+
+from shadelab.errors import ShadeLabError
+from shadelab.resources import presets_dir
+from shadelab.scene.model import (
+    MAX_LIGHTS,
+    SCHEMA_VERSION,
+    Camera,
+    Light,
+    Material,
+    Object,
+    RadiositySettings,
+    RaytraceSettings,
+    RenderSettings,
+    Scene,
+)
+
+_SECTIONS = {
+    "camera": Camera,
+    "render": RenderSettings,
+    "raytrace": RaytraceSettings,
+    "radiosity": RadiositySettings,
+}
+
+
+# ---------------------------------------------------------------- finding presets
+
+
+def list_presets() -> list[str]:
+    """Names of the presets shipped with ShadeLab, sorted."""
+    return sorted(p.stem for p in presets_dir().glob("*.toml"))
+
+
+def resolve_preset(name_or_path: str) -> Path:
+    """A preset name from ``presets/`` or a path to a TOML file."""
+    path = Path(name_or_path)
+    if path.suffix == ".toml" or path.exists() or "/" in name_or_path:
+        if not path.is_file():
+            raise ShadeLabError(f"{name_or_path}: preset file not found")
+        return path
+    candidate = presets_dir() / f"{name_or_path}.toml"
+    if not candidate.is_file():
+        names = ", ".join(list_presets())
+        raise ShadeLabError(f"unknown preset '{name_or_path}' "
+                            f"(expected one of: {names}, or a path)")
+    return candidate
+
+
+# ---------------------------------------------------------------- loading
+
+
+def load_preset(name_or_path: str, overrides: list[str] | None = None) -> Scene:
+    """Load, override and validate a preset; the result is a :class:`Scene`."""
+    path = resolve_preset(name_or_path)
+    raw = read_toml(path)
+    for item in overrides or []:
+        apply_override(raw, item, str(path))
+    scene = scene_from_dict(raw, str(path))
+    scene.name = path.stem
+    scene.base_dir = str(path.resolve().parent)
+    return scene
+
+
+def read_toml(path: Path) -> dict:
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ShadeLabError(f"{path}: cannot read preset ({exc.strerror})") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ShadeLabError(f"{path}: TOML syntax error: {exc}") from None
+
+
+def scene_from_dict(raw: dict, source: str = "<preset>") -> Scene:
+    """Validate a preset dictionary into a Scene; unknown keys are errors."""
+    if not isinstance(raw, dict):
+        raise ShadeLabError(f"{source}: expected a table at the top level")
+    data = dict(raw)
+    version = data.pop("schema_version", None)
+    if version != SCHEMA_VERSION:
+        raise ShadeLabError(
+            f"{source}: key 'schema_version': expected {SCHEMA_VERSION}, got {version!r}")
+    scene = Scene()
+    for key, value in data.items():
+        if key in _SECTIONS:
+            setattr(scene, key, _build(_SECTIONS[key], value, source, key))
+        elif key == "lights":
+            scene.lights = [_build(Light, item, source, f"lights.{i}")
+                            for i, item in enumerate(_as_list(value, source, key))]
+        elif key == "objects":
+            scene.objects = [_build(Object, item, source, f"objects.{i}")
+                             for i, item in enumerate(_as_list(value, source, key))]
+        elif key == "materials":
+            if not isinstance(value, dict):
+                raise ShadeLabError(f"{source}: key 'materials': expected a table of materials")
+            scene.materials = {name: _build(Material, item, source, f"materials.{name}")
+                               for name, item in value.items()}
+        elif key in ("description", "Ia"):
+            setattr(scene, key, _check(Scene, key, value, source, key))
+        else:
+            raise ShadeLabError(f"{source}: unknown key '{key}' (expected one of: "
+                                f"schema_version, description, Ia, camera, lights, materials, "
+                                f"objects, render, raytrace, radiosity)")
+    _cross_check(scene, source)
+    return scene
+
+
+def _as_list(value: Any, source: str, key: str) -> list:
+    if not isinstance(value, list):
+        raise ShadeLabError(f"{source}: key '{key}': expected an array of tables")
+    return value
+
+
+def _build(cls: type, value: Any, source: str, where: str):
+    if not isinstance(value, dict):
+        raise ShadeLabError(f"{source}: key '{where}': expected a table")
+    names = {f.name for f in dataclasses.fields(cls) if "spec" in f.metadata}
+    obj = cls()
+    for key, item in value.items():
+        if key not in names:
+            raise ShadeLabError(f"{source}: unknown key '{where}.{key}' "
+                                f"(expected one of: {', '.join(sorted(names))})")
+        setattr(obj, key, _check(cls, key, item, source, f"{where}.{key}"))
+    return obj
+
+
+def _field_spec(cls: type, key: str) -> tuple:
+    for f in dataclasses.fields(cls):
+        if f.name == key:
+            return f.metadata["spec"]
+    raise KeyError(key)
+
+
+def _number(value: Any, source: str, where: str, what: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ShadeLabError(f"{source}: key '{where}': expected {what}, got {value!r}")
+    if not math.isfinite(value):
+        raise ShadeLabError(f"{source}: key '{where}': expected {what}, got {value!r} (not finite)")
+    return float(value)
+
+
+def _vec3(value: Any, source: str, where: str, what: str, minimum: float | None = None):
+    if not isinstance(value, (list, tuple)) or len(value) != 3:
+        raise ShadeLabError(f"{source}: key '{where}': expected {what}, got {value!r}")
+    out = tuple(_number(v, source, where, what) for v in value)
+    if minimum is not None and min(out) < minimum:
+        raise ShadeLabError(f"{source}: key '{where}': expected {what}, got {value!r}")
+    return out
+
+
+def _check(cls: type, key: str, value: Any, source: str, where: str) -> Any:
+    """Validate one value against its field spec and return it in canonical form."""
+    kind, *args = _field_spec(cls, key)
+    if kind == "float":
+        lo, hi = args
+        what = f"a number in [{lo:g}, {hi:g}]"
+        out = _number(value, source, where, what)
+        if not lo <= out <= hi:
+            raise ShadeLabError(f"{source}: key '{where}': expected {what}, got {value!r}")
+        return out
+    if kind == "int":
+        lo, hi = args
+        what = f"an integer in [{lo}, {hi}]"
+        if isinstance(value, bool) or not isinstance(value, int) or not lo <= value <= hi:
+            raise ShadeLabError(f"{source}: key '{where}': expected {what}, got {value!r}")
+        return int(value)
+    if kind == "bool":
+        if not isinstance(value, bool):
+            raise ShadeLabError(f"{source}: key '{where}': expected true or false, got {value!r}")
+        return value
+    if kind == "str":
+        (choices,) = args
+        if not isinstance(value, str) or (choices and value not in choices):
+            expected = " | ".join(choices) if choices else "a string"
+            raise ShadeLabError(f"{source}: key '{where}': expected {expected}, got {value!r}")
+        return value
+    if kind == "rgb":
+        return _vec3(value, source, where, "three numbers >= 0 (linear RGB)", minimum=0.0)
+    if kind == "rgb01":
+        out = _vec3(value, source, where, "three numbers in [0, 1] (a reflectance color)",
+                    minimum=0.0)
+        if max(out) > 1.0:
+            raise ShadeLabError(f"{source}: key '{where}': expected three numbers in [0, 1] "
+                                f"(a reflectance color), got {value!r}")
+        return out
+    if kind == "vec3":
+        return _vec3(value, source, where, "three finite numbers")
+    if kind == "vec3s":
+        if not isinstance(value, list):
+            raise ShadeLabError(f"{source}: key '{where}': expected a list of [x, y, z] points")
+        return [_vec3(v, source, where, "a list of [x, y, z] points") for v in value]
+    raise AssertionError(kind)
+
+
+def _cross_check(scene: Scene, source: str) -> None:
+    """Checks that span tables: material references, required shape keys, light count."""
+    if len(scene.lights) > MAX_LIGHTS:
+        raise ShadeLabError(f"{source}: key 'lights': at most {MAX_LIGHTS} lights, "
+                            f"got {len(scene.lights)}")
+    for i, obj in enumerate(scene.objects):
+        if obj.material not in scene.materials:
+            if obj.material == "default":
+                scene.materials.setdefault("default", Material())
+            else:
+                names = ", ".join(scene.materials) or "none defined"
+                raise ShadeLabError(f"{source}: key 'objects.{i}.material': expected a material "
+                                    f"name ({names}), got '{obj.material}'")
+        if obj.shape == "quad" and len(obj.vertices) != 4:
+            raise ShadeLabError(f"{source}: key 'objects.{i}.vertices': expected 4 points "
+                                f"for a quad, got {len(obj.vertices)}")
+        if obj.shape == "mesh" and not obj.path:
+            raise ShadeLabError(f"{source}: key 'objects.{i}.path': expected a mesh file path")
+        if min(abs(s) for s in obj.scale) == 0.0:
+            raise ShadeLabError(f"{source}: key 'objects.{i}.scale': expected non-zero scales")
+    for i, light in enumerate(scene.lights):
+        if light.kind != "point" and sum(d * d for d in light.direction) == 0.0:
+            raise ShadeLabError(f"{source}: key 'lights.{i}.direction': expected a non-zero vector")
+        if light.attenuation == "lecture" and light.c1 + light.c2 + light.c3 == 0.0:
+            # f_att = min(1/0, 1) = 1: allowed, the clamp makes it finite (failure gallery)
+            pass
+    cam = scene.camera
+    if sum((a - b) ** 2 for a, b in zip(cam.eye, cam.target, strict=True)) == 0.0:
+        raise ShadeLabError(f"{source}: key 'camera.target': expected a point other than the eye")
+
+
+# ---------------------------------------------------------------- --set overrides
+
+
+def parse_value(text: str) -> Any:
+    """Parse a ``--set`` value: TOML scalars, ``a,b,c`` lists, or a bare string."""
+    text = text.strip()
+    if "," in text and not text.startswith("["):
+        return [parse_value(part) for part in text.split(",")]
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        lowered = text.lower()
+        if lowered in ("nan", "+nan", "-nan", "inf", "+inf", "-inf"):
+            return float(lowered)
+        return text
+
+
+def apply_override(raw: dict, item: str, source: str = "--set") -> None:
+    """Apply ``KEY=VALUE`` to a preset dictionary; ``lights.0.Ip=2,2,2`` indexes arrays."""
+    if "=" not in item:
+        raise ShadeLabError(f"--set '{item}': expected KEY=VALUE, e.g. materials.white.kd=0.5")
+    key, value = item.split("=", 1)
+    parts = key.strip().split(".")
+    node: Any = raw
+    for depth, part in enumerate(parts[:-1]):
+        node = _descend(node, part, parts[: depth + 1], source)
+    last = parts[-1]
+    if isinstance(node, list):
+        index = _index(node, last, parts, source)
+        node[index] = parse_value(value)
+    elif isinstance(node, dict):
+        node[last] = parse_value(value)
+    else:
+        raise ShadeLabError(f"--set '{key}': '{'.'.join(parts[:-1])}' is not a table")
+
+
+def _descend(node: Any, part: str, path: list[str], source: str) -> Any:
+    dotted = ".".join(path)
+    if isinstance(node, list):
+        return node[_index(node, part, path, source)]
+    if isinstance(node, dict):
+        if part not in node:
+            if path[0] in _SECTIONS and len(path) == 1:
+                node[part] = {}
+            else:
+                raise ShadeLabError(f"--set '{dotted}': no such key in {source}")
+        return node[part]
+    raise ShadeLabError(f"--set '{dotted}': not a table or an array")
+
+
+def _index(node: list, part: str, path: list[str], source: str) -> int:
+    if not part.isdigit() or int(part) >= len(node):
+        raise ShadeLabError(f"--set '{'.'.join(path)}': expected an index below {len(node)} "
+                            f"in {source}")
+    return int(part)
+
+
+# ---------------------------------------------------------------- saving
+
+
+def scene_to_dict(scene: Scene) -> dict:
+    """The preset dictionary of a scene: every field written, so a reload is exact."""
+
+    def table(obj) -> dict:
+        out = {}
+        for f in dataclasses.fields(obj):
+            if "spec" not in f.metadata:
+                continue
+            value = getattr(obj, f.name)
+            if isinstance(value, tuple):
+                value = list(value)
+            if f.name == "vertices":
+                value = [list(v) for v in value]
+            out[f.name] = value
+        return out
+
+    data: dict[str, Any] = {"schema_version": SCHEMA_VERSION, "description": scene.description,
+                            "Ia": list(scene.Ia)}
+    for key in _SECTIONS:
+        data[key] = table(getattr(scene, key))
+    data["materials"] = {name: table(m) for name, m in scene.materials.items()}
+    data["lights"] = [table(light) for light in scene.lights]
+    data["objects"] = [table(obj) for obj in scene.objects]
+    return data
+
+
+def save_preset(scene: Scene, path: str | Path) -> None:
+    """Write the scene as a TOML preset, through a temporary file so nothing is half-written."""
+    path = Path(path)
+    tmp = path.with_name(path.name + ".tmp")
+    try:
+        tmp.write_text(tomli_w.dumps(scene_to_dict(scene)), encoding="utf-8")
+        tmp.replace(path)
+    except OSError as exc:
+        raise ShadeLabError(f"{path}: cannot write preset ({exc.strerror})") from None
+
+
+def clone_scene(scene: Scene) -> Scene:
+    return copy.deepcopy(scene)

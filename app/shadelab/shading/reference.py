@@ -1,0 +1,246 @@
+"""The lighting equation of the lecture, once, in vectorized numpy.
+
+Conventions (see :mod:`shadelab.shading.conventions`): ``to_light`` and ``to_eye`` point away from
+the surface; normals are unit; colors are linear RGB; arrays broadcast over leading axes
+(``(..., 3)`` vectors, ``(...)`` scalars).
+
+``shaders/include/lighting.glsl`` mirrors every function here with the same name and
+argument order; ``tests/test_glsl_parity.py`` holds the two together.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from shadelab.scene.model import Light, Material
+
+_EPS = 1e-12
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.sum(a * b, axis=-1)
+
+
+def normalize(v: np.ndarray) -> np.ndarray:
+    """Unit vectors; a zero vector stays zero instead of becoming NaN."""
+    length = np.linalg.norm(v, axis=-1, keepdims=True)
+    return np.where(length > _EPS, v / np.maximum(length, _EPS), 0.0)
+
+
+def lambert(n: np.ndarray, to_light: np.ndarray) -> np.ndarray:
+    """Lambert's cosine law, clamped.
+
+    Notes
+    -----
+    cos(theta) = max(N . L, 0)
+    """
+    return np.maximum(_dot(n, to_light), 0.0)
+
+
+def reflect_light(n: np.ndarray, to_light: np.ndarray) -> np.ndarray:
+    """The mirror direction of ``to_light`` about ``n``.
+
+    Notes
+    -----
+    R = 2 N (N . L) - L
+    """
+    return 2.0 * n * _dot(n, to_light)[..., None] - to_light
+
+
+def _power(cosine: np.ndarray, shininess: np.ndarray) -> np.ndarray:
+    """cos^n for cos > 0, else 0; n = 0 gives 1 inside the lobe (no 0^0 ambiguity)."""
+    c = np.maximum(cosine, 0.0)
+    return np.where(c > 0.0, np.power(np.maximum(c, _EPS), shininess), 0.0)
+
+
+def phong_specular(n: np.ndarray, to_light: np.ndarray, to_eye: np.ndarray,
+                   shininess: np.ndarray) -> np.ndarray:
+    """Phong's specular term; zero where the light is behind the surface.
+
+    Notes
+    -----
+    (R . V)^n with R = 2 N (N . L) - L
+    """
+    lit = _dot(n, to_light) > 0.0
+    return np.where(lit, _power(_dot(reflect_light(n, to_light), to_eye), shininess), 0.0)
+
+
+def halfway(to_light: np.ndarray, to_eye: np.ndarray) -> np.ndarray:
+    """H = (L + V) / |L + V|; zero when L = -V (guarded)."""
+    return normalize(to_light + to_eye)
+
+
+def blinn_phong_specular(n: np.ndarray, to_light: np.ndarray, to_eye: np.ndarray,
+                         shininess: np.ndarray) -> np.ndarray:
+    """Blinn-Phong's specular term; zero where the light is behind the surface.
+
+    Notes
+    -----
+    (N . H)^n with H = (L + V) / |L + V|
+    """
+    lit = _dot(n, to_light) > 0.0
+    return np.where(lit, _power(_dot(n, halfway(to_light, to_eye)), shininess), 0.0)
+
+
+ATTENUATION_CODES = {"none": 0, "inverse_square": 1, "lecture": 2}
+
+
+def attenuation(distance: np.ndarray, mode: str, c1: float, c2: float, c3: float) -> np.ndarray:
+    """Light-source attenuation f_att at ``distance`` (inf for a directional light: 1).
+
+    Notes
+    -----
+    none:           f_att = 1
+    inverse_square: f_att = 1 / d^2
+    lecture:        f_att = min(1 / (c1 + c2 d + c3 d^2), 1)
+    """
+    d = np.asarray(distance, dtype=np.float64)
+    finite = np.isfinite(d)
+    dd = np.where(finite, d, 0.0)
+    if mode == "none":
+        f = np.ones_like(dd)
+    elif mode == "inverse_square":
+        f = 1.0 / np.maximum(dd * dd, _EPS)
+    elif mode == "lecture":
+        denominator = c1 + c2 * dd + c3 * dd * dd
+        f = np.minimum(1.0 / np.maximum(denominator, _EPS), 1.0)
+    else:
+        raise ValueError(f"unknown attenuation mode {mode!r}")
+    return np.where(finite, f, 1.0)
+
+
+def attenuation_clamped(distance: np.ndarray, light: Light) -> np.ndarray:
+    """True where the lecture's min(..., 1) clamp is active (the probe shows it)."""
+    if light.attenuation != "lecture":
+        return np.zeros(np.shape(distance), dtype=bool)
+    d = np.asarray(distance, dtype=np.float64)
+    finite = np.isfinite(d)
+    dd = np.where(finite, d, 0.0)
+    return finite & ((light.c1 + light.c2 * dd + light.c3 * dd * dd) <= 1.0)
+
+
+def spot_factor(to_light: np.ndarray, axis: np.ndarray, cos_cone: float,
+                exponent: float) -> np.ndarray:
+    """Spotlight cone (Warn): (cos phi)^e inside the cone, 0 outside.
+
+    Notes
+    -----
+    cos phi = (-L) . D, with D the unit spot axis; inside when phi <= cone angle.
+    """
+    cos_phi = _dot(-to_light, axis)
+    inside = cos_phi >= cos_cone
+    return np.where(inside, np.power(np.maximum(cos_phi, 0.0), exponent), 0.0)
+
+
+def light_vectors(light: Light, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Unit ``to_light`` vectors and distances from surface points to a light.
+
+    A directional light is at infinite distance along ``-direction``.
+    """
+    position = np.asarray(position, dtype=np.float64)
+    if light.kind == "directional":
+        to_light = normalize(-np.asarray(light.direction, dtype=np.float64))
+        to_light = np.broadcast_to(to_light, position.shape)
+        return to_light, np.full(position.shape[:-1], np.inf)
+    delta = np.asarray(light.position, dtype=np.float64) - position
+    distance = np.linalg.norm(delta, axis=-1)
+    return normalize(delta), distance
+
+
+@dataclass
+class LightTerms:
+    """One light's contribution at each point, split the way the lecture writes it."""
+
+    to_light: np.ndarray      # (..., 3) unit
+    distance: np.ndarray      # (...) world units, inf for directional
+    f_att: np.ndarray         # (...) attenuation
+    clamp_active: np.ndarray  # (...) bool, lecture's min(., 1) clamped to 1
+    spot: np.ndarray          # (...) spot cone factor (1 for other kinds)
+    shadow: np.ndarray        # (...) S_i in [0, 1]
+    diffuse: np.ndarray       # (..., 3) S f_att spot Ip kd Od (N.L)
+    specular: np.ndarray      # (..., 3) S f_att spot Ip ks Os (R.V)^n or (N.H)^n
+
+
+@dataclass
+class ShadeTerms:
+    emission: np.ndarray      # (..., 3) self-luminous radiance (area lights), 0 elsewhere
+    ambient: np.ndarray       # (..., 3) Ia ka Od
+    lights: list[LightTerms]
+
+    @property
+    def total(self) -> np.ndarray:
+        out = self.emission + self.ambient
+        for term in self.lights:
+            out = out + term.diffuse + term.specular
+        return out
+
+
+def _material_arrays(material: Material, od: np.ndarray | None, shape: tuple):
+    od_arr = np.asarray(material.Od if od is None else od, dtype=np.float64)
+    return np.broadcast_to(od_arr, shape + (3,)), np.asarray(material.Os, dtype=np.float64)
+
+
+def shade_terms(position: np.ndarray, normal: np.ndarray, eye: np.ndarray, material: Material,
+                lights: list[Light], Ia, specular: str = "phong",
+                shadow: list[np.ndarray] | None = None,
+                od: np.ndarray | None = None) -> ShadeTerms:
+    """Every term of the lecture's equation at each point.
+
+    Parameters
+    ----------
+    position : (..., 3) float, world space
+    normal : (..., 3) float, unit, world space (flipped by the caller for back faces)
+    eye : (3,) float, world space camera position
+    material : the coefficients ka, kd, ks, n, Od, Os
+    lights : the enabled lights, each with its Ip, attenuation and cone
+    Ia : (3,) ambient intensity
+    specular : "phong" for (R.V)^n or "blinn" for (N.H)^n
+    shadow : one S_i array (...) per light, 1 = lit; default all lit
+    od : (..., 3) optional per-point diffuse color (textures), replacing material.Od
+
+    Notes
+    -----
+    I = Le + Ia ka Od + sum_i S_i f_att,i Ip,i [kd Od (N.L_i) + ks Os (R_i.V)^n]
+
+    Le is the material's emission (zero but for self-luminous surfaces such as the Cornell
+    box's ceiling light), so an area light is visible in every renderer.
+    """
+    position = np.asarray(position, dtype=np.float64)
+    n = np.asarray(normal, dtype=np.float64)
+    shape = position.shape[:-1]
+    od_arr, os_arr = _material_arrays(material, od, shape)
+    to_eye = normalize(np.asarray(eye, dtype=np.float64) - position)
+    ambient = np.asarray(Ia, dtype=np.float64) * material.ka * od_arr
+    spec_fn = blinn_phong_specular if specular == "blinn" else phong_specular
+    terms = []
+    for i, light in enumerate(lights):
+        to_light, distance = light_vectors(light, position)
+        f_att = attenuation(distance, light.attenuation, light.c1, light.c2, light.c3)
+        if light.kind == "spot":
+            axis = normalize(np.asarray(light.direction, dtype=np.float64))
+            spot = spot_factor(to_light, axis, np.cos(np.radians(light.cone_angle)),
+                               light.spot_exponent)
+        else:
+            spot = np.ones(shape)
+        s = np.ones(shape) if shadow is None else np.broadcast_to(shadow[i], shape)
+        scale = (s * f_att * spot)[..., None] * np.asarray(light.Ip, dtype=np.float64)
+        diffuse = scale * material.kd * od_arr * lambert(n, to_light)[..., None]
+        spec = scale * material.ks * os_arr * spec_fn(n, to_light, to_eye, material.n)[..., None]
+        terms.append(LightTerms(to_light, distance, f_att, attenuation_clamped(distance, light),
+                                spot, s, diffuse, spec))
+    emission = np.broadcast_to(np.asarray(material.emission, dtype=np.float64), shape + (3,))
+    return ShadeTerms(emission, ambient, terms)
+
+
+def shade(position: np.ndarray, normal: np.ndarray, eye: np.ndarray, material: Material,
+          lights: list[Light], Ia, specular: str = "phong",
+          shadow: list[np.ndarray] | None = None, od: np.ndarray | None = None) -> np.ndarray:
+    """The lecture's illumination I (..., 3) at each point; see :func:`shade_terms`.
+
+    Notes
+    -----
+    I = Ia ka Od + sum_i S_i f_att,i Ip,i [kd Od (N.L_i) + ks Os (R_i.V)^n]
+    """
+    return shade_terms(position, normal, eye, material, lights, Ia, specular, shadow, od).total

@@ -1,0 +1,736 @@
+"""The interactive viewer: imgui-bundle docking layout, viewport in the middle.
+
+GL resources are created in ``callbacks.post_init`` (moderngl attaches to the window's
+context) and freed in ``callbacks.before_exit``. Panels live in :mod:`shadelab.ui.panels`; this
+module holds the viewport window, the shortcut table and the per-frame bookkeeping (undo
+snapshots, autosave, window title).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+from imgui_bundle import hello_imgui, imgui, immapp
+
+from shadelab.geometry.mesh import geometry_key, scene_meshes
+from shadelab.scene.model import Camera
+from shadelab.ui import overlays, panels
+from shadelab.ui.offline import draw_offline_panel
+from shadelab.ui.probe import probe
+from shadelab.ui.state import AUTOSAVE_INTERVAL, COMPARE_LABELS, COMPARE_VIEWS, AppState, save_session
+from shadelab.ui.studies_panel import draw_gallery_panel, draw_studies_panel
+
+ORBIT_SPEED = 0.008        # radians per pixel dragged
+ZOOM_STEP = 0.9            # eye-target distance factor per wheel notch
+CLICK_SLOP = 3.0           # pixels a click may move and still probe
+PRESENTER_SCALE = 1.8      # font scale of presenter mode
+WARM_JOBS_AT_FRAME = 60    # start the offline-job process once the window is up
+WINDOW_BG = imgui.ImVec4(0.06, 0.06, 0.06, 1.0)  # the dark theme's panel color, opaque
+
+
+@dataclass
+class ViewerOptions:
+    """Command-line extras: scripted frames, screenshots, tests and the bench."""
+
+    frames: int = 0                       # quit after this many frames (0: run until closed)
+    screenshot: str = ""                  # whole-window PNG written at exit
+    window_size: tuple[int, int] = (1600, 900)
+    probe: tuple[int, int] | None = None  # viewport pixel probed at start
+    job: str = ""                         # offline job started at start (label prefix)
+    bench_json: str = ""                  # frame times written here at exit
+    autosave: bool = True
+    show_radiosity: bool = False          # once a radiosity job ends, show its solution
+    ray_tree: tuple[int, int] | None = None  # once a Whitted job ends, trace this pixel's tree
+    focus: str = ""                       # dock windows brought to front at start (a,b,...)
+    study: str = ""                       # study run (quick) at start; --frames counts after it
+    gallery: str = ""                     # failure-gallery case selected and opened at start
+    test_function: Callable | None = None  # immapp.testing test body (GUI tests)
+
+
+# ---------------------------------------------------------------- camera moves
+
+
+def orbit(camera: Camera, dx: float, dy: float) -> None:
+    """Turn the eye around the target: dx about the up axis, dy over the top."""
+    eye, target = np.asarray(camera.eye, float), np.asarray(camera.target, float)
+    up = np.asarray(camera.up, float) / np.linalg.norm(camera.up)
+    offset = eye - target
+    radius = np.linalg.norm(offset)
+    d = offset / radius
+    right = np.cross(up, d)
+    right = right / max(np.linalg.norm(right), 1e-12)
+    forward = np.cross(right, up)
+    elevation = math.asin(max(-1.0, min(1.0, float(np.dot(d, up)))))
+    azimuth = math.atan2(float(np.dot(d, right)), float(np.dot(d, forward)))
+    azimuth -= dx * ORBIT_SPEED
+    elevation = max(-1.5, min(1.5, elevation + dy * ORBIT_SPEED))
+    new_d = (math.cos(elevation) * (math.cos(azimuth) * forward + math.sin(azimuth) * right)
+             + math.sin(elevation) * up)
+    camera.eye = tuple(float(c) for c in target + radius * new_d)
+
+
+def pan(camera: Camera, dx: float, dy: float, height: int) -> None:
+    """Slide eye and target together so the scene follows the mouse."""
+    eye, target = np.asarray(camera.eye, float), np.asarray(camera.target, float)
+    forward = target - eye
+    distance = np.linalg.norm(forward)
+    forward /= distance
+    right = np.cross(forward, camera.up)
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    per_pixel = 2.0 * distance * math.tan(math.radians(camera.fov_y) / 2.0) / max(height, 1)
+    shift = (-dx * right + dy * up) * per_pixel
+    camera.eye = tuple(float(c) for c in eye + shift)
+    camera.target = tuple(float(c) for c in target + shift)
+
+
+def zoom(camera: Camera, notches: float) -> None:
+    eye, target = np.asarray(camera.eye, float), np.asarray(camera.target, float)
+    offset = (eye - target) * (ZOOM_STEP ** notches)
+    if np.linalg.norm(offset) > camera.near * 2.0:
+        camera.eye = tuple(float(c) for c in target + offset)
+
+
+# ---------------------------------------------------------------- shortcuts
+
+
+def _set(attr: str, value) -> Callable[[AppState], None]:
+    def action(state: AppState) -> None:
+        setattr(state.scene.render, attr, value)
+        state.mark_edited()
+    return action
+
+
+def _toggle(attr: str) -> Callable[[AppState], None]:
+    def action(state: AppState) -> None:
+        setattr(state, attr, not getattr(state, attr))
+    return action
+
+
+def _toggle_blinn(state: AppState) -> None:
+    render = state.scene.render
+    render.specular = "phong" if render.specular == "blinn" else "blinn"
+    state.mark_edited()
+
+
+def _screenshot(state: AppState) -> None:
+    name = state.scene.name or "scene"
+    folder = Path(state.screenshot_dir)
+    index = 1
+    while (folder / f"shadelab-{name}-{index:03d}.png").exists():
+        index += 1
+    state.screenshot_requested = str(folder / f"shadelab-{name}-{index:03d}.png")
+
+
+def _save(state: AppState) -> None:
+    state.save_as(state.preset_path or state.open_path)
+
+
+K = imgui.Key
+CTRL = imgui.Key.mod_ctrl
+# (key chord, shown as, what it does, action) — the help overlay lists this table.
+SHORTCUTS = (
+    (K._1, "1", "flat shading", _set("shading", "flat")),
+    (K._2, "2", "Gouraud shading", _set("shading", "gouraud")),
+    (K._3, "3", "Phong shading", _set("shading", "phong")),
+    (K.b, "B", "Blinn-Phong / Phong specular", _toggle_blinn),
+    (K.w, "W", "wireframe", _toggle("show_wireframe")),
+    (K.n, "N", "normal glyphs", _toggle("show_normals")),
+    (K.c, "C", "compare 2x2", _toggle("compare")),
+    (K.d, "D", "difference heat map (compare)", _toggle("diff_enabled")),
+    (K.r, "R", "reset view", AppState.reset_view),
+    (K.s, "S", "screenshot of the viewport", _screenshot),
+    (K.f, "F", "presenter mode (large fonts)", _toggle("presenter")),
+    (K.h, "H", "this help", _toggle("show_help")),
+    (K.f1, "F1", "this help", _toggle("show_help")),
+    (CTRL | K.z, "Ctrl+Z", "undo", AppState.undo),
+    (CTRL | K.y, "Ctrl+Y", "redo", AppState.redo),
+    (CTRL | K.s, "Ctrl+S", "save the preset", _save),
+)
+MOUSE_HELP = (("left drag", "orbit"), ("right / middle drag", "pan"), ("wheel", "zoom"),
+              ("left click", "probe the pixel"))
+
+
+def handle_shortcuts(state: AppState) -> None:
+    """Run the action of each pressed chord (not while typing in a text field)."""
+    if imgui.get_io().want_text_input:
+        return
+    for chord, _, _, action in SHORTCUTS:
+        if imgui.is_key_chord_pressed(chord):
+            action(state)
+
+
+def draw_help_overlay(state: AppState) -> None:
+    if not state.show_help:
+        return
+    imgui.set_next_window_bg_alpha(0.9)
+    expanded, opened = imgui.begin("Help", True, imgui.WindowFlags_.always_auto_resize)
+    if expanded:
+        for _, keys, what, _ in SHORTCUTS:
+            imgui.text(f"{keys:>8}  {what}")
+        imgui.separator()
+        for keys, what in MOUSE_HELP:
+            imgui.text(f"{keys:>20}  {what}")
+    imgui.end()
+    if not opened:
+        state.show_help = False
+
+
+# ---------------------------------------------------------------- the viewer
+
+
+@dataclass
+class Viewer:
+    state: AppState
+    options: ViewerOptions
+    viewport: object = None            # shadelab.ui.viewport.Viewport, made in post_init
+    drag: float = 0.0                  # pixels moved since the mouse went down
+    last_autosave: float = 0.0
+    title: str = ""
+    frame_times: list = field(default_factory=list)
+    first_frame: float = 0.0
+    started: float = field(default_factory=time.perf_counter)
+    _line_cache: dict = field(default_factory=dict)
+    _frame_key: tuple = ()
+    force_redraw: bool = False         # the bench's later phases: re-render every frame
+    force_interactive: bool = False    # the bench's last phase: as if a slider were dragged
+    redrawn: bool = False              # this frame re-rendered the scene
+    redraw_flags: list = field(default_factory=list)
+    cpu_times: list = field(default_factory=list)
+    _job_followed_up: bool = False
+    _study_done_at: int = 0            # frame the --study run ended
+
+    # ------------------------------------------------------------ GL lifetime
+    def post_init(self) -> None:
+        from shadelab.gl.context import attach_to_current
+        from shadelab.ui.viewport import Viewport
+
+        self.viewport = Viewport(attach_to_current())
+        self.state.gl = self.viewport
+        if self.options.probe is not None:
+            self.state.probe_pixel, self.state.probe_requested = self.options.probe, True
+        if self.options.focus:
+            focus_windows(hello_imgui.get_runner_params().docking_params.dockable_windows,
+                          self.options.focus)
+        if self.options.gallery:
+            self._open_gallery_case(self.options.gallery)
+        if self.options.study:
+            from shadelab.ui.studies_panel import start_study
+
+            start_study(self.state, self.options.study)
+        if self.options.job:
+            from shadelab.ui.offline import start_job_by_label
+
+            start_job_by_label(self.state, self.options.job)
+
+    def _open_gallery_case(self, name: str) -> None:
+        from shadelab.studies.gallery import GALLERY
+        from shadelab.ui.studies import open_case
+
+        names = [case.name for case in GALLERY]
+        if name not in names:
+            self.state.error = f"--gallery '{name}': expected one of {', '.join(names)}"
+            return
+        self.state.gallery_index = names.index(name)
+        open_case(self.state, GALLERY[self.state.gallery_index])
+
+    def before_exit(self) -> None:
+        self.state.job.shutdown()
+        if self.state.study is not None:
+            self.state.study.shutdown()
+        if self.options.autosave:
+            self.autosave(force=True)
+        if self.options.bench_json:
+            self.write_bench()
+        if self.viewport is not None:
+            self.viewport.release()
+            self.viewport = None
+
+    # ------------------------------------------------------------ viewport window
+    def draw_viewport_window(self) -> None:
+        state = self.state
+        avail = imgui.get_content_region_avail()
+        size = (max(int(avail.x), 16), max(int(avail.y) - 4, 16))
+        if size != state.viewport_size and state.probe_pixel is not None:
+            state.probe_requested = True  # the same pixel shows another point now
+        state.viewport_size = size
+        if state.compare:
+            self.draw_compare(size)
+        else:
+            self.draw_main(size)
+        if state.error:
+            imgui.set_cursor_pos(imgui.ImVec2(12, 40))
+            imgui.text_colored(panels.ERROR_COLOR, f"Error: {state.error}")
+
+    def _image_with_input(self, texture, size: tuple[int, int]) -> tuple[float, float] | None:
+        """Show the texture; handle orbit/pan/zoom; return the clicked pixel, if any."""
+        state = self.state
+        origin = imgui.get_cursor_screen_pos()
+        imgui.image(imgui.ImTextureRef(texture.glo), imgui.ImVec2(*size),
+                    uv0=imgui.ImVec2(0, 1), uv1=imgui.ImVec2(1, 0))
+        imgui.set_cursor_screen_pos(origin)
+        imgui.invisible_button("viewport_input", imgui.ImVec2(*size),
+                               imgui.ButtonFlags_.mouse_button_left
+                               | imgui.ButtonFlags_.mouse_button_right
+                               | imgui.ButtonFlags_.mouse_button_middle)
+        io = imgui.get_io()
+        camera = state.scene.camera
+        if imgui.is_item_activated():
+            self.drag = 0.0
+        if imgui.is_item_active():
+            dx, dy = io.mouse_delta.x, io.mouse_delta.y
+            self.drag += abs(dx) + abs(dy)
+            if self.drag > CLICK_SLOP and (dx or dy):
+                if imgui.is_mouse_down(imgui.MouseButton_.left):
+                    orbit(camera, dx, dy)
+                else:
+                    pan(camera, dx, dy, size[1])
+                state.mark_edited()
+        if imgui.is_item_hovered() and io.mouse_wheel:
+            zoom(camera, io.mouse_wheel)
+            state.mark_edited()
+        if imgui.is_item_deactivated() and self.drag <= CLICK_SLOP \
+                and imgui.is_mouse_released(imgui.MouseButton_.left):
+            mouse = io.mouse_pos
+            return mouse.x - origin.x, mouse.y - origin.y
+        return None
+
+    def frame_key(self, size: tuple[int, int]) -> tuple:
+        """Everything the viewport image depends on; an unchanged key reuses the last image."""
+        s = self.state
+        probe_id = s.probe_version
+        return (repr(s.scene), size, s.compare, s.diff_enabled, s.diff_pair, s.diff_scale,
+                s.show_wireframe, s.show_normals, s.normal_length, probe_id, s.overlay_version,
+                s.show_radiosity)
+
+    def unchanged(self, size: tuple[int, int]) -> bool:
+        """True when the last image is still right (idle frames only redraw the GUI)."""
+        key = self.frame_key(size)
+        redraw = self.force_redraw or self.state.probe_requested \
+            or bool(self.state.screenshot_requested) or key != self._frame_key
+        self._frame_key = key
+        self.redrawn = redraw
+        return not redraw
+
+    def draw_main(self, size: tuple[int, int]) -> None:
+        state, vp = self.state, self.viewport
+        scene = state.scene
+        display_size, size = size, self.render_size(size)
+        if "main" in vp.panes and self.unchanged(size):
+            self._handle_click(self._image_with_input(vp.panes["main"].display, display_size),
+                               display_size)
+            return
+        # --- PASS 1-2: the scene into the float target (the Renderer's passes), or the solved
+        # radiosity meshes, Gouraud-interpolated (view-independent: walk around them)
+        radiosity = state.show_radiosity and state.radiosity_soup is not None
+        if radiosity:
+            pane = vp.pane("main", size)
+            vp.draw_colored_triangles(pane, scene, state.radiosity_soup)
+        else:
+            pane = vp.draw_scene("main", scene, size, scene.render.shading, scene.render.specular)
+        # --- PASS 3: the probe reads the GPU value before any overlay is drawn
+        if state.probe_requested:
+            self.update_probe(size, display_size)
+        # --- PASS 4: overlays (wireframe, normal glyphs, probe arrows)
+        exposure = scene.render.exposure
+        meshes = scene_meshes(scene)
+        if state.show_wireframe:
+            vp.draw_lines(pane, self.cached_lines("wire", meshes), exposure)
+        if state.show_normals:
+            vp.draw_lines(pane, self.cached_lines("normals", meshes), exposure)
+        if state.probe is not None:
+            length = 0.12 * overlays.scene_diagonal(meshes)
+            vp.draw_lines(pane, overlays.probe_arrows(state.probe, length), exposure,
+                          depth_test=False)
+        if state.ray_tree is not None:
+            lines = overlays.ray_tree_lines(state.ray_tree, overlays.scene_diagonal(meshes))
+            vp.draw_lines(pane, lines, exposure, depth_test=False)
+        # --- PASS 5: exposure + sRGB for display
+        texture = vp.present(pane, exposure)
+        if state.screenshot_requested:
+            self.write_viewport_screenshot(state.screenshot_requested)
+            state.screenshot_requested = ""
+        self._handle_click(self._image_with_input(texture, display_size), display_size)
+
+    def interacting(self) -> bool:
+        """A slider or the camera is being dragged right now."""
+        return self.force_interactive or (self.state.edit_pending and imgui.is_any_item_active())
+
+    def render_size(self, size: tuple[int, int]) -> tuple[int, int]:
+        """The scene's resolution: the viewport's times the render scale (lower mid-drag)."""
+        scale = self.state.render_scale
+        if self.interacting():
+            scale = min(scale, self.state.interactive_scale)
+        return max(int(size[0] * scale), 8), max(int(size[1] * scale), 8)
+
+    def _handle_click(self, clicked, size: tuple[int, int]) -> None:
+        if clicked is not None:
+            x, y = int(clicked[0]), int(clicked[1])
+            if 0 <= x < size[0] and 0 <= y < size[1]:
+                self.state.probe_pixel, self.state.probe_requested = (x, y), True
+
+    def cached_lines(self, kind: str, meshes) -> np.ndarray:
+        scene, state = self.state.scene, self.state
+        key = (kind, tuple(geometry_key(o, scene.base_dir) for o in scene.objects),
+               scene.render.shading, state.normal_length)
+        if key not in self._line_cache:
+            if len(self._line_cache) > 8:
+                self._line_cache.clear()
+            if kind == "wire":
+                lines = overlays.wireframe(meshes)
+            else:
+                length = state.normal_length * overlays.scene_diagonal(meshes)
+                lines = overlays.normal_glyphs(meshes, length, scene.render.shading)
+            self._line_cache[key] = lines
+        return self._line_cache[key]
+
+    def update_probe(self, size: tuple[int, int], display_size: tuple[int, int]) -> None:
+        """Recompute the probed pixel's terms (CPU reference) and read what the GPU drew.
+
+        ``state.probe_pixel`` is in viewport pixels; the scene may be rendered at another
+        resolution (render scale), so the pixel is mapped to the rendered image first.
+        """
+        state = self.state
+        shown = state.probe_pixel
+        if shown is None or not (0 <= shown[0] < display_size[0]
+                                 and 0 <= shown[1] < display_size[1]):
+            state.probe = None
+            state.probe_version += 1
+            return  # (kept requested: the layout may still be settling)
+        pixel = (min(int(shown[0] * size[0] / display_size[0]), size[0] - 1),
+                 min(int(shown[1] * size[1] / display_size[1]), size[1] - 1))
+        state.probe_requested = False
+        result = probe(state.scene, size, pixel)
+        if result is not None and not state.show_radiosity:
+            result.gpu = self.viewport.read_pixel("main", pixel)
+        state.probe = result
+        state.probe_version += 1
+        if result is None:
+            state.status = f"pixel {pixel}: background (no surface)"
+
+    def draw_compare(self, size: tuple[int, int]) -> None:
+        state, vp = self.state, self.viewport
+        scene = state.scene
+        # Four quadrants; with the heat map, the map takes 70% of the width at full height.
+        if state.diff_enabled:
+            half = (max(int(size[0] * 0.7), 8), max(size[1], 8))
+        else:
+            half = (max(size[0] // 2, 8), max(size[1] // 2, 8))
+        exposure = scene.render.exposure
+        if "compare3" in vp.panes and self.unchanged(size):
+            panes = [vp.panes[f"compare{i}"] for i in range(len(COMPARE_VIEWS))]
+        else:
+            panes = [vp.draw_scene(f"compare{i}", scene, half, shading, specular)
+                     for i, (shading, specular) in enumerate(COMPARE_VIEWS)]
+        if state.diff_enabled:
+            a, b = state.diff_pair
+            diff = vp.pane("diff", half)
+            vp.present(diff, exposure, panes[a], panes[b], state.diff_scale)
+            origin = imgui.get_cursor_screen_pos()
+            texture = diff.display
+            self._image_with_input(texture, half)
+            draw = imgui.get_window_draw_list()
+            draw.add_text(imgui.ImVec2(origin.x + 6, origin.y + 4), 0xFFFFFFFF,
+                          f"|{COMPARE_LABELS[a]} - {COMPARE_LABELS[b]}| x exposure, "
+                          f"full red = {state.diff_scale:.3g}")
+            imgui.same_line()
+            imgui.begin_group()
+            thumb_w = max(size[0] - half[0] - 12, 8)
+            thumb_h = min(thumb_w * half[1] / half[0], size[1] / 2 - 30)
+            for i in (a, b):
+                tex = vp.present(panes[i], exposure)
+                imgui.image(imgui.ImTextureRef(tex.glo),
+                            imgui.ImVec2(thumb_h * half[0] / half[1], thumb_h),
+                            uv0=imgui.ImVec2(0, 1), uv1=imgui.ImVec2(1, 0))
+                imgui.text(COMPARE_LABELS[i])
+            imgui.end_group()
+            return
+        origin = imgui.get_cursor_screen_pos()
+        for pane in panes:
+            vp.present(pane, exposure)
+        draw = imgui.get_window_draw_list()
+        for i, pane in enumerate(panes):
+            x = origin.x + (i % 2) * half[0]
+            y = origin.y + (i // 2) * half[1]
+            imgui.set_cursor_screen_pos(imgui.ImVec2(x, y))
+            imgui.image(imgui.ImTextureRef(pane.display.glo), imgui.ImVec2(*half),
+                        uv0=imgui.ImVec2(0, 1), uv1=imgui.ImVec2(1, 0))
+            draw.add_text(imgui.ImVec2(x + 6, y + 4), 0xFFFFFFFF, COMPARE_LABELS[i])
+        # One input area over the grid drives the shared camera.
+        imgui.set_cursor_screen_pos(origin)
+        self._grid_input((half[0] * 2, half[1] * 2), half[1])
+
+    def _grid_input(self, size: tuple[int, int], pane_height: int) -> None:
+        state, io = self.state, imgui.get_io()
+        imgui.invisible_button("compare_input", imgui.ImVec2(*size),
+                               imgui.ButtonFlags_.mouse_button_left
+                               | imgui.ButtonFlags_.mouse_button_right)
+        camera = state.scene.camera
+        if imgui.is_item_active() and (io.mouse_delta.x or io.mouse_delta.y):
+            if imgui.is_mouse_down(imgui.MouseButton_.left):
+                orbit(camera, io.mouse_delta.x, io.mouse_delta.y)
+            else:
+                pan(camera, io.mouse_delta.x, io.mouse_delta.y, pane_height)
+            state.mark_edited()
+        if imgui.is_item_hovered() and io.mouse_wheel:
+            zoom(camera, io.mouse_wheel)
+            state.mark_edited()
+
+    # ------------------------------------------------------------ screenshots
+    def write_viewport_screenshot(self, path: str) -> None:
+        from PIL import Image
+
+        from shadelab.ui.legend import burn_legend
+
+        image = self.viewport.read_display("main")
+        if self.state.legend_in_screenshot:
+            image = burn_legend(image, self.state)
+        try:
+            Image.fromarray(image).save(path)
+            self.state.status = f"screenshot {path}"
+        except (OSError, ValueError) as exc:
+            self.state.error = f"screenshot '{path}': cannot write ({exc})"
+
+    # ------------------------------------------------------------ per frame
+    def panel(self, draw: Callable[[AppState], bool]) -> Callable[[], None]:
+        def gui() -> None:
+            if draw(self.state):
+                self.state.mark_edited()
+        return gui
+
+    def end_frame(self) -> None:
+        """Shortcuts, undo snapshots, autosave, title, scripted exit."""
+        state = self.state
+        handle_shortcuts(state)
+        draw_help_overlay(state)
+        scale = PRESENTER_SCALE if state.presenter else 1.0
+        style = imgui.get_style()
+        if style.font_scale_main != scale:  # only on change: a new scale re-bakes glyphs
+            style.font_scale_main = scale
+        if state.edit_pending and not imgui.is_any_item_active():
+            state.commit_edit()
+        if self.options.autosave:
+            self.autosave()
+        self.update_title()
+        now = time.perf_counter()
+        if not self.first_frame:
+            self.first_frame = now
+        self.frame_times.append(now)
+        self.cpu_times.append(time.process_time())
+        self.redraw_flags.append(0 if not self.redrawn else (2 if self.force_interactive else 1))
+        state.frame += 1
+        if state.frame == WARM_JOBS_AT_FRAME and not (self.options.frames
+                                                      or self.options.test_function) \
+                and state.job.worker is not None:
+            state.job.worker.warm()  # after start-up: the first job then starts at once
+        if self.options.bench_json and self.options.frames:
+            # Phases: idle (GUI only), full-resolution redraw, interactive (drag) redraw.
+            third = self.options.frames // 3
+            self.force_redraw = state.frame >= third
+            self.force_interactive = state.frame >= 2 * third
+        waiting = self.options.job and (state.job.running or not state.job.started
+                                        or state.job_version != state.job.version)
+        if state.study is not None:
+            state.study.poll()  # also while the Studies tab is hidden
+            if self.options.study and not self._study_done_at and not state.study.running:
+                self._study_done_at = state.frame
+            # --frames counts after the study ends (the plot fits its axes over a few frames)
+            waiting = waiting or (self.options.study and (
+                state.study.running
+                or state.frame < self._study_done_at + min(self.options.frames, 10)))
+        if self.options.job and not waiting and not self._job_followed_up:
+            self._job_followed_up = True
+            self.follow_up_job()
+        if self.options.frames and state.frame >= self.options.frames and not waiting:
+            hello_imgui.get_runner_params().app_shall_exit = True
+
+    def follow_up_job(self) -> None:
+        """The command line's after-job requests: radiosity in the viewport, a ray tree."""
+        state = self.state
+        if self.options.show_radiosity and state.radiosity_soup is not None:
+            state.show_radiosity = True
+        if self.options.ray_tree is not None and state.job_scene is not None:
+            from shadelab.ui.offline import trace_tree
+
+            trace_tree(state, self.options.ray_tree)
+
+    def autosave(self, force: bool = False) -> None:
+        state = self.state
+        now = time.perf_counter()
+        if not state.autosave_due or state.edit_pending and not force:
+            return
+        if not force and now - self.last_autosave < AUTOSAVE_INTERVAL:
+            return
+        try:
+            save_session(state.scene, state.source)
+            state.autosave_due = False
+        except Exception as exc:  # a full disk must not take the session down
+            state.error = f"autosave failed: {exc}"
+        self.last_autosave = now
+
+    def update_title(self) -> None:
+        title = self.state.title()
+        if title == self.title:
+            return
+        self.title = title
+        try:
+            import glfw
+            from imgui_bundle import glfw_utils
+
+            glfw.set_window_title(glfw_utils.glfw_window_hello_imgui(), title)
+        except Exception:  # no GLFW backend (tests with a mock): the title is cosmetic
+            pass
+
+    def write_bench(self) -> None:
+        """Frame times of idle frames (GUI only) and of frames that re-render the scene."""
+        times = np.diff(np.asarray(self.frame_times)) * 1000.0
+        flags = np.asarray(self.redraw_flags[1:])
+        report = {"first_frame_s": self.first_frame_since_start(),
+                  "frames": len(self.frame_times), "window": list(self.options.window_size)}
+        cpu = np.diff(np.asarray(self.cpu_times)) * 1000.0
+        for name, select in (("idle", flags == 0), ("redraw", flags == 1),
+                             ("interactive", flags == 2)):
+            picked, picked_cpu = times[select][5:], cpu[select][5:]  # skip warm-up frames
+            if len(picked):
+                report[f"{name}_frame_ms_median"] = float(np.median(picked))
+                report[f"{name}_frame_ms_max"] = float(np.max(picked))
+                report[f"{name}_cpu_ms_median"] = float(np.median(picked_cpu))
+        Path(self.options.bench_json).write_text(json.dumps(report), encoding="utf-8")
+
+    def first_frame_since_start(self) -> float:
+        """Seconds from process start to the first frame (Linux /proc; else since Viewer())."""
+        try:
+            import os
+
+            ticks = os.sysconf("SC_CLK_TCK")
+            start = int(Path("/proc/self/stat").read_text().rsplit(")", 1)[1].split()[19]) / ticks
+            uptime_now = float(Path("/proc/uptime").read_text().split()[0])
+            return uptime_now - start - (time.perf_counter() - self.first_frame)
+        except (OSError, ValueError, IndexError):
+            return self.first_frame - self.started
+
+
+# ---------------------------------------------------------------- layout and run
+
+
+def _docking(viewer: Viewer) -> hello_imgui.DockingParams:
+    def split(initial: str, new: str, direction, ratio: float) -> hello_imgui.DockingSplit:
+        s = hello_imgui.DockingSplit()
+        s.initial_dock, s.new_dock, s.direction, s.ratio = initial, new, direction, ratio
+        return s
+
+    def window(label: str, dock: str, gui: Callable[[], None]) -> hello_imgui.DockableWindow:
+        w = hello_imgui.DockableWindow()
+        w.label, w.dock_space_name, w.gui_function = label, dock, gui
+        return w
+
+    params = hello_imgui.DockingParams()
+    params.docking_splits = [
+        split("MainDockSpace", "LeftSpace", imgui.Dir.left, 0.24),
+        split("MainDockSpace", "RightSpace", imgui.Dir.right, 0.36),
+        split("RightSpace", "RightBottom", imgui.Dir.down, 0.40),
+    ]
+    p = viewer.panel
+    params.dockable_windows = [
+        window("Scene", "LeftSpace", p(_scene_panel)),
+        window("Lights", "LeftSpace", p(panels.draw_lights_panel)),
+        window("Materials", "LeftSpace", p(panels.draw_materials_panel)),
+        window("Objects", "LeftSpace", p(panels.draw_objects_panel)),
+        window("Viewport", "MainDockSpace", viewer.draw_viewport_window),
+        window("Equation & probe", "RightSpace", p(panels.draw_equation_panel)),
+        window("Studies", "RightSpace", p(draw_studies_panel)),
+        window("Failure gallery", "RightSpace", p(draw_gallery_panel)),
+        window("Offline render", "RightBottom", p(draw_offline_panel)),
+    ]
+    for w in params.dockable_windows:
+        # llvmpipe is fill-bound: the window clear (same color) replaces every panel's
+        # background quad, about 16 ms a frame at 1280x720 on two cores.
+        w.imgui_window_flags = imgui.WindowFlags_.no_background
+    params.dockable_windows[0].focus_window_at_next_frame = True
+    params.dockable_windows[5].focus_window_at_next_frame = True  # the right column's first tab
+    return params
+
+
+def focus_windows(windows, focus: str) -> list[str]:
+    """Bring the named dock windows to the front: ``focus`` is a comma-separated list of label
+    prefixes (or words of a label: 'gallery' finds 'Failure gallery'); one window per dock
+    space. Returns the labels focused."""
+    chosen: dict[str, object] = {}
+    for wanted in (w.strip().lower() for w in focus.split(",") if w.strip()):
+        match = [w for w in windows if w.label.lower().startswith(wanted)] \
+            or [w for w in windows if wanted in w.label.lower()]
+        if match:
+            chosen[match[0].dock_space_name] = match[0]
+    for window in windows:
+        if window.dock_space_name in chosen:
+            window.focus_window_at_next_frame = window is chosen[window.dock_space_name]
+    return [w.label for w in chosen.values()]
+
+
+def _scene_panel(state: AppState) -> bool:
+    panels.draw_file_panel(state)
+    imgui.separator()
+    edited = panels.draw_render_panel(state)
+    imgui.separator()
+    panels.draw_compare_panel(state)
+    _, state.presenter = imgui.checkbox("Presenter mode (F)", state.presenter)
+    imgui.same_line()
+    _, state.show_help = imgui.checkbox("Help (H)", state.show_help)
+    if imgui.button("Screenshot (S)"):
+        _screenshot(state)
+    imgui.same_line()
+    _, state.legend_in_screenshot = imgui.checkbox("with legend", state.legend_in_screenshot)
+    if imgui.button("Reset view (R)"):
+        state.reset_view()
+    _, state.render_scale = panels._slider("render scale", state.render_scale, 0.25, 1.0)
+    _, state.interactive_scale = panels._slider("while dragging", state.interactive_scale,
+                                                0.25, 1.0)
+    return edited
+
+
+def runner_params(viewer: Viewer) -> hello_imgui.RunnerParams:
+    params = hello_imgui.RunnerParams()
+    params.app_window_params.window_title = viewer.state.title()
+    params.app_window_params.window_geometry.size = viewer.options.window_size
+    params.imgui_window_params.default_imgui_window_type = \
+        hello_imgui.DefaultImGuiWindowType.provide_full_screen_dock_space
+    params.imgui_window_params.enable_viewports = False
+    params.imgui_window_params.background_color = WINDOW_BG
+    params.docking_params = _docking(viewer)
+    params.ini_disable = True
+    # Idle at a few fps when nothing moves (frees the CPU for offline jobs); the bench and the
+    # GUI tests measure and drive every frame.
+    params.fps_idling.enable_idling = not (viewer.options.bench_json or viewer.options.test_function
+                                           or viewer.options.frames)
+    params.callbacks.post_init = viewer.post_init
+    params.callbacks.before_exit = viewer.before_exit
+    params.callbacks.post_new_frame = lambda: None
+    params.callbacks.show_gui = viewer.end_frame
+    return params
+
+
+def run_viewer(state: AppState, options: ViewerOptions) -> int:
+    """Open the window and run until it is closed (or ``options.frames`` frames)."""
+    viewer = Viewer(state, options)
+    params = runner_params(viewer)
+    addons = immapp.AddOnsParams(with_implot=True)
+    if options.test_function is not None:
+        from imgui_bundle.immapp import testing
+
+        testing.run(test_function=lambda ctx: options.test_function(ctx, state),
+                    runner_params=params, add_ons_params=addons)
+    else:
+        immapp.run(params, addons)
+    if options.screenshot:
+        from PIL import Image
+
+        image = hello_imgui.final_app_window_screenshot()
+        Image.fromarray(image).save(options.screenshot)
+        print(f"wrote {options.screenshot} ({image.shape[1]}x{image.shape[0]})")
+    return 0

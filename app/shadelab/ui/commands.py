@@ -1,0 +1,125 @@
+"""``shadelab view [PRESET]`` (also plain ``shadelab [PRESET]``): the interactive viewer."""
+
+from __future__ import annotations
+
+import argparse
+import os
+
+from shadelab.errors import ShadeLabError
+
+DEFAULT_PRESET = "cornell"
+NO_DISPLAY = ("no display (DISPLAY and WAYLAND_DISPLAY are unset): use 'shadelab render PRESET "
+              "-o OUT.png' for images without a window, or install Xvfb and run "
+              "'xvfb-run -a shadelab'")
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("view", help="open the interactive viewer (default preset: cornell)")
+    p.add_argument("preset", nargs="?", metavar="PRESET",
+                   help="preset name from presets/ or a path (default: the last session, or "
+                        "cornell)")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a preset value, e.g. materials.white.kd=0.5")
+    p.add_argument("--fresh", action="store_true", help="ignore the autosaved session")
+    p.add_argument("--window", default="1600x900", metavar="WxH", help="window size")
+    p.add_argument("--frames", type=int, default=0, metavar="N", help="quit after N frames")
+    p.add_argument("--screenshot", metavar="PATH", help="write a PNG of the window at exit")
+    p.add_argument("--compare", action="store_true", help="start in 2x2 compare mode")
+    p.add_argument("--diff", action="store_true", help="with --compare: show the heat map")
+    p.add_argument("--probe", metavar="X,Y", help="probe this viewport pixel at start")
+    p.add_argument("--job", metavar="NAME", help="start this offline render at start "
+                   "(e.g. 'reference', 'whitted', 'path', 'radiosity'); --frames counts "
+                   "after it ends")
+    p.add_argument("--show-radiosity", action="store_true",
+                   help="with --job radiosity: draw the solution in the viewport when done")
+    p.add_argument("--ray-tree", metavar="X,Y",
+                   help="with --job whitted: draw the ray tree of this pixel of its image")
+    p.add_argument("--focus", metavar="PANEL[,PANEL]", help="bring these panels' tabs to the "
+                   "front (Scene, Lights, Materials, Objects, Equation, Studies, Gallery, ...)")
+    p.add_argument("--study", metavar="NAME", help="run this study (quick) in the Studies panel "
+                   "at start (shading, raytrace, radiosity, shadows); --frames counts after it")
+    p.add_argument("--gallery", metavar="CASE", help="select this failure-gallery case and open "
+                   "it in the viewer at start (e.g. gouraud-highlight)")
+    p.add_argument("--presenter", action="store_true", help="large fonts for a projector")
+    p.add_argument("--wireframe", action="store_true", help="show the wireframe")
+    p.add_argument("--normals", action="store_true", help="show normal glyphs")
+    p.add_argument("--help-overlay", action="store_true", help="show the shortcut help")
+    p.add_argument("--no-autosave", action="store_true", help="do not write the session")
+    p.add_argument("--bench-json", help=argparse.SUPPRESS)
+    p.set_defaults(run=run_view)
+
+
+def _pixel(text: str, flag: str) -> tuple[int, int]:
+    try:
+        x, y = (int(v) for v in text.split(","))
+    except ValueError:
+        raise ShadeLabError(f"{flag} '{text}': expected an X,Y pixel, e.g. 300,200") from None
+    if x < 0 or y < 0:
+        raise ShadeLabError(f"{flag} '{text}': expected non-negative pixel coordinates")
+    return x, y
+
+
+def _check_study_and_case(args: argparse.Namespace) -> None:
+    """--study and --gallery name something that exists (one-line error otherwise)."""
+    if args.study:
+        from shadelab.studies import STUDIES
+
+        names = [name for name, _ in STUDIES]
+        if args.study not in names:
+            raise ShadeLabError(f"--study '{args.study}': expected one of {', '.join(names)}")
+    if args.gallery:
+        from shadelab.studies.gallery import GALLERY
+
+        names = [case.name for case in GALLERY]
+        if args.gallery not in names:
+            raise ShadeLabError(f"--gallery '{args.gallery}': expected one of "
+                                f"{', '.join(names)}")
+
+
+def load_scene(args: argparse.Namespace):
+    """(scene, source, restored): the autosaved session if it matches, else the preset."""
+    from shadelab.scene.preset import load_preset
+    from shadelab.ui.state import load_session
+
+    if not args.fresh and not args.set:
+        session = load_session()
+        if session is not None and args.preset in (None, session[1]):
+            print(f"shadelab: restored the autosaved session of '{session[1]}' "
+                  f"(--fresh to start from the preset)")
+            return (*session, True)
+    name = args.preset or DEFAULT_PRESET
+    return load_preset(name, args.set), name, False
+
+
+def run_view(args: argparse.Namespace) -> int:
+    if not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
+        raise ShadeLabError(NO_DISPLAY)
+    from shadelab.imageio import check_writable, parse_size
+
+    window = parse_size(args.window)
+    check_writable(args.screenshot, "--screenshot")
+    probe = _pixel(args.probe, "--probe") if args.probe else None
+    ray_tree = _pixel(args.ray_tree, "--ray-tree") if args.ray_tree else None
+    if args.frames < 0:
+        raise ShadeLabError(f"--frames {args.frames}: expected a count >= 0")
+    _check_study_and_case(args)
+    scene, source, restored = load_scene(args)
+    from shadelab.geometry.mesh import scene_meshes
+
+    scene_meshes(scene)  # a broken mesh file fails here, with its one-line reason
+    from shadelab.ui.app import ViewerOptions, run_viewer
+    from shadelab.ui.state import AppState
+
+    state = AppState.from_scene(scene, source)
+    if restored:
+        state.status = f"restored the autosaved session of '{source}'"
+    state.compare, state.diff_enabled = args.compare, args.diff
+    state.presenter, state.show_help = args.presenter, args.help_overlay
+    state.show_wireframe, state.show_normals = args.wireframe, args.normals
+    options = ViewerOptions(frames=args.frames, screenshot=args.screenshot or "",
+                            window_size=window, probe=probe, job=args.job or "",
+                            bench_json=args.bench_json or "", autosave=not args.no_autosave,
+                            show_radiosity=args.show_radiosity, ray_tree=ray_tree,
+                            focus=args.focus or "", study=args.study or "",
+                            gallery=args.gallery or "")
+    return run_viewer(state, options)

@@ -1,0 +1,380 @@
+"""Offline renders off the UI thread: a generic runner over any ``Iterator[Progress]``.
+
+A job whose factory can be pickled (every renderer on offer) runs in a worker *process*, so
+numba compilation or a GIL-holding kernel never stalls the UI, and a cancel that does not land
+within ``KILL_AFTER`` seconds ends the process; anything else (a closure, a test's generator)
+runs in a worker thread. Either way the UI polls :meth:`JobRunner.snapshot`.
+
+The renderers (Whitted, path tracer, radiosity) are found lazily, so the viewer runs whether or
+not those layers exist yet; a missing one is listed as "not available" with the reason.
+Pure module: threads, processes and numpy only, no GL.
+"""
+
+from __future__ import annotations
+
+import importlib
+import multiprocessing
+import pickle
+import queue
+import sys
+import threading
+import time
+from dataclasses import dataclass
+from typing import Callable, Iterator
+
+import numpy as np
+
+from shadelab.progress import Progress
+from shadelab.scene.camera import primary_rays
+from shadelab.scene.model import Scene
+from shadelab.scene.preset import clone_scene
+
+JobFactory = Callable[[Scene, tuple[int, int]], Iterator[Progress]]
+KILL_AFTER = 3.0   # seconds a cancelled process job may take before its process is ended
+
+
+def _picklable(step: Progress) -> Progress:
+    """The Progress itself, or a copy without the stats entries that cannot cross processes."""
+    try:
+        pickle.dumps(step)
+        return step
+    except Exception:
+        stats = {}
+        for key, value in step.stats.items():
+            try:
+                pickle.dumps(value)
+                stats[key] = value
+            except Exception:
+                stats[key] = f"<{type(value).__name__}>"
+        return Progress(step.image, step.fraction, step.message, stats)
+
+
+def _process_main(tasks, results, cancel) -> None:
+    """The worker process: run each (job_id, factory, scene, size) task, streaming Progress."""
+    import os
+
+    parent = os.getppid()
+    while True:
+        try:
+            task = tasks.get(timeout=1.0)
+        except queue.Empty:
+            if os.getppid() != parent:
+                return  # the viewer is gone (crashed or killed): do not linger
+            continue
+        if task is None:
+            return
+        job_id, factory, scene, size = task
+        gen, error, cancelled = None, "", False
+        try:
+            gen = factory(scene, size)
+            for step in gen:
+                results.put(("progress", job_id, _picklable(step)))
+                if cancel.is_set():
+                    cancelled = True
+                    break
+        except Exception as exc:
+            error = f"{type(exc).__name__}: {exc}"
+        finally:
+            if gen is not None and hasattr(gen, "close"):
+                gen.close()
+        results.put(("done", job_id, error, cancelled))
+
+
+class WorkerProcess:
+    """One long-lived spawned process that runs jobs one at a time (started on first use)."""
+
+    def __init__(self) -> None:
+        self._mp = multiprocessing.get_context("spawn")
+        self.process = None
+        self.tasks = self.results = self.cancel = None
+
+    def ensure(self) -> None:
+        if self.process is not None and self.process.is_alive():
+            return
+        self.tasks, self.results = self._mp.Queue(), self._mp.Queue()
+        self.cancel = self._mp.Event()
+        self.process = self._mp.Process(target=_process_main, name="shadelab-jobs", daemon=True,
+                                        args=(self.tasks, self.results, self.cancel))
+        # A spawned child re-imports the parent's __main__ (here ``shadelab/__main__.py``, which
+        # would start another viewer); hide it while the child's start-up data is taken.
+        main = sys.modules.get("__main__")
+        saved = {k: main.__dict__[k] for k in ("__spec__", "__file__") if k in main.__dict__}
+        try:
+            main.__spec__ = None
+            main.__dict__.pop("__file__", None)
+            self.process.start()
+        finally:
+            main.__dict__.update(saved)
+
+    def warm(self) -> None:
+        """Start the process and import the renderers in it ahead of the first job."""
+        self.ensure()
+        self.tasks.put((0, warm_up, None, None))
+
+    def kill(self) -> None:
+        if self.process is not None and self.process.is_alive():
+            self.process.terminate()
+            self.process.join(2.0)
+        self.process = None
+
+    def shutdown(self) -> None:
+        if self.process is not None and self.process.is_alive():
+            self.tasks.put(None)
+            self.process.join(1.0)
+        self.kill()
+
+
+class JobRunner:
+    """Runs one progressive job in a worker thread; the UI polls ``latest``.
+
+    Cancel sets a flag the worker checks between chunks, then closes the generator, as the
+    progress contract asks (chunks stay under 0.2 s, so a cancel lands within one chunk).
+    """
+
+    def __init__(self, use_process: bool = True) -> None:
+        self.use_process = use_process
+        self.worker = WorkerProcess() if use_process else None
+        self.in_process = False         # the current job runs in the worker process
+        self._job_id = 0
+        self.name = ""
+        self.latest: Progress | None = None
+        self.error = ""
+        self.started = 0.0
+        self.finished = 0.0
+        self.cancelled = False
+        self.cancel_requested = 0.0     # perf_counter() of the last cancel
+        self.version = 0                # bumps on every new Progress (the UI re-uploads then)
+        self._cancel = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._lock = threading.Lock()
+
+    @property
+    def running(self) -> bool:
+        return self._thread is not None and self._thread.is_alive()
+
+    @property
+    def elapsed(self) -> float:
+        """Seconds since the job started (frozen when it ends)."""
+        if not self.started:
+            return 0.0
+        return (self.finished or time.perf_counter()) - self.started
+
+    def start(self, name: str, make: Callable[[], Iterator[Progress]],
+              call: tuple | None = None) -> None:
+        """Start a job; a running one is cancelled first.
+
+        ``call`` = (factory, scene, size) runs ``factory(scene, size)`` in the worker process
+        when it pickles; otherwise ``make()``'s generator runs in a thread.
+        """
+        self.cancel(wait=True)
+        self.name, self.latest, self.error, self.cancelled = name, None, "", False
+        self.started, self.finished = time.perf_counter(), 0.0
+        self._cancel.clear()
+        self._job_id += 1
+        self.in_process = bool(self.use_process and call is not None and _pickles(call))
+        if self.in_process:
+            self.worker.ensure()
+            self.worker.cancel.clear()
+            self.worker.tasks.put((self._job_id, *call))
+            target, args = self._listen, (self._job_id,)
+        else:
+            target, args = self._work, (make,)
+        self._thread = threading.Thread(target=target, args=args, daemon=True,
+                                        name=f"shadelab-job-{name}")
+        self._thread.start()
+
+    def _listen(self, job_id: int) -> None:
+        """Relay the worker process's Progress; end it if a cancel does not land in time."""
+        worker = self.worker
+        while True:
+            if self._cancel.is_set() and time.perf_counter() - self.cancel_requested > KILL_AFTER:
+                worker.kill()
+                self.cancelled = True
+                break
+            if not worker.process or not worker.process.is_alive():
+                self.error = self.error or "the job's worker process ended unexpectedly"
+                break
+            try:
+                message = worker.results.get(timeout=0.05)
+            except queue.Empty:
+                continue
+            if message[1] != job_id:
+                continue  # a late message of an earlier job
+            if message[0] == "progress":
+                with self._lock:
+                    self.latest = message[2]
+                    self.version += 1
+            else:
+                self.error, self.cancelled = message[2], message[3]
+                break
+        self.finished = time.perf_counter()
+
+    def _work(self, make: Callable[[], Iterator[Progress]]) -> None:
+        gen = None
+        try:
+            gen = make()
+            for step in gen:
+                with self._lock:
+                    self.latest = step
+                    self.version += 1
+                if self._cancel.is_set():
+                    self.cancelled = True
+                    break
+        except Exception as exc:  # shown in the panel; the UI keeps running
+            self.error = f"{type(exc).__name__}: {exc}"
+        finally:
+            if gen is not None and hasattr(gen, "close"):
+                gen.close()
+            self.finished = time.perf_counter()
+
+    def cancel(self, wait: bool = False, timeout: float = 5.0) -> None:
+        if self.running and not self._cancel.is_set():
+            self.cancel_requested = time.perf_counter()
+        self._cancel.set()
+        if self.in_process and self.worker.cancel is not None:
+            self.worker.cancel.set()
+        if wait and self._thread is not None:
+            self._thread.join(timeout)
+
+    def shutdown(self) -> None:
+        """Cancel the job and end the worker process (the viewer is closing)."""
+        self.cancel(wait=True, timeout=1.0)
+        if self.worker is not None:
+            self.worker.shutdown()
+
+    def snapshot(self) -> tuple[Progress | None, int]:
+        with self._lock:
+            return self.latest, self.version
+
+
+# ---------------------------------------------------------------- the jobs on offer
+
+
+def iter_reference_raster(scene: Scene, size: tuple[int, int], rows_per_chunk: int = 8):
+    """A CPU render with the numpy reference (ray cast + Phong-mode shading), rows at a time.
+
+    Always available: it checks the GPU image pixel for pixel and exercises the job panel.
+    """
+    from shadelab.geometry.mesh import scene_meshes
+    from shadelab.shading.reference import normalize, shade
+    from shadelab.ui.probe import _facing, intersect_many
+
+    scene = clone_scene(scene)
+    width, height = size
+    meshes = scene_meshes(scene)
+    origins, directions = primary_rays(scene.camera, width, height)
+    image = np.zeros((height, width, 3), np.float32)
+    eye = np.asarray(scene.camera.eye, dtype=np.float64)
+    for y0 in range(0, height, rows_per_chunk):
+        o = origins[y0:y0 + rows_per_chunk].reshape(-1, 3)
+        d = directions[y0:y0 + rows_per_chunk].reshape(-1, 3)
+        mesh_id, face, t, bary = intersect_many(meshes, o, d)
+        out = np.zeros((len(o), 3))
+        for m, mesh in enumerate(meshes):
+            sel = np.flatnonzero(mesh_id == m)
+            if not len(sel):
+                continue
+            f = face[sel]
+            p = o[sel] + t[sel, None] * d[sel]
+            n = normalize(np.einsum("ij,ijk->ik", bary[sel], mesh.corner_normals[f]))
+            n = _facing(n, mesh.face_normals[f], normalize(eye - p))
+            out[sel] = shade(p, n, eye, scene.materials[mesh.material], scene.active_lights(),
+                             scene.Ia, scene.render.specular)
+        image[y0:y0 + rows_per_chunk] = out.reshape(-1, width, 3)
+        done = min(y0 + rows_per_chunk, height)
+        yield Progress(image.copy(), done / height, f"rows {done}/{height}")
+    yield Progress(image, 1.0, "done", {"pixels": width * height})
+
+
+@dataclass
+class JobKind:
+    """One offline renderer the panel offers."""
+
+    label: str
+    make: JobFactory | None     # None: not available
+    reason: str = ""            # why not, when make is None
+    raster_shading: str = "phong"  # the raster view it is compared against
+
+
+def _lookup(module: str, names: tuple[str, ...]):
+    """The first of ``names`` in ``module``, or (None, reason)."""
+    try:
+        mod = importlib.import_module(module)
+    except ImportError as exc:
+        return None, f"{module} not available ({exc})"
+    for name in names:
+        if hasattr(mod, name):
+            return getattr(mod, name), ""
+    return None, f"{module} has none of {', '.join(names)}"
+
+
+def _pickles(value) -> bool:
+    try:
+        pickle.dumps(value)
+        return True
+    except Exception:
+        return False
+
+
+WHITTED = (("shadelab.raytrace", "shadelab.raytrace.whitted", "shadelab.raytrace.tracer"),
+           ("iter_whitted", "iter_raytrace"))
+PATHTRACE = (("shadelab.raytrace.pathtrace",), ("iter_pathtrace",))
+RADIOSITY = (("shadelab.radiosity", "shadelab.radiosity.solver"), ("iter_radiosity",))
+
+
+def _find(spec) -> tuple[Callable | None, str]:
+    modules, names = spec
+    reason = ""
+    for module in modules:
+        fn, reason = _lookup(module, names)
+        if fn is not None:
+            return fn, ""
+    return None, reason
+
+
+def warm_up(scene, size) -> Iterator[Progress]:
+    """Import every renderer (numba caches load, embree starts); yields nothing."""
+    for modules, _ in (WHITTED, PATHTRACE, RADIOSITY):
+        for module in modules:
+            try:
+                importlib.import_module(module)
+            except ImportError:
+                pass
+    return iter(())
+
+
+# Module-level factories (picklable by reference, so they run in the worker process).
+def run_whitted(scene: Scene, size: tuple[int, int]) -> Iterator[Progress]:
+    return _find(WHITTED)[0](scene, size)
+
+
+def run_pathtrace(scene: Scene, size: tuple[int, int], seed: int = 1) -> Iterator[Progress]:
+    """The path tracer at the scene's samples per pixel (the panel sets them)."""
+    return _find(PATHTRACE)[0](scene, size, max(scene.raytrace.spp, 1), seed)
+
+
+def run_radiosity(scene: Scene, size: tuple[int, int]) -> Iterator[Progress]:
+    """Radiosity with ray-cast form factors: the GPU hemicube would need a GL context of its
+    own in the worker (the viewer's context belongs to the UI thread)."""
+    method = "raycast" if scene.radiosity.form_factors == "hemicube" else None
+    return _find(RADIOSITY)[0](scene, size, form_factors=method)
+
+
+def available_jobs() -> list[JobKind]:
+    """The offline renderers, each with a factory or the reason it is missing."""
+    kinds = [JobKind("Reference raster (numpy)", iter_reference_raster)]
+    for label, spec, run in (("Whitted ray tracer", WHITTED, run_whitted),
+                             ("Path tracer (reference GI)", PATHTRACE, run_pathtrace),
+                             ("Radiosity", RADIOSITY, run_radiosity)):
+        fn, reason = _find(spec)
+        kinds.append(JobKind(label, run if fn is not None else None, reason,
+                             "gouraud" if label == "Radiosity" else "phong"))
+    return kinds
+
+
+def difference(a: np.ndarray, b: np.ndarray) -> dict:
+    """Error figures between two linear images of the same shape."""
+    diff = np.abs(np.asarray(a, np.float64) - np.asarray(b, np.float64))
+    scale = max(float(np.abs(b).max()), 1e-12)
+    return {"rmse": float(np.sqrt(np.mean(diff ** 2))), "max_abs": float(diff.max()),
+            "relative_rmse": float(np.sqrt(np.mean(diff ** 2)) / scale)}

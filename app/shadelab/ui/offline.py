@@ -1,0 +1,233 @@
+"""The offline-render side panel: start/cancel a job, watch it, compare it with the raster view."""
+
+from __future__ import annotations
+
+import numpy as np
+from imgui_bundle import imgui
+
+from shadelab.scene.preset import clone_scene
+from shadelab.shading.conventions import to_srgb8
+from shadelab.ui import panels
+from shadelab.ui.jobs import available_jobs, difference
+from shadelab.ui.state import AppState
+
+SIZES = (32, 64, 96, 128, 192, 256, 384, 512)
+SAMPLES = (1, 4, 16, 64, 256)
+
+
+def heat_map(a: np.ndarray, b: np.ndarray, scale: float) -> np.ndarray:
+    """(H, W, 3) uint8: max-channel |a - b| / scale through black-blue-green-yellow-red."""
+    t = np.clip(np.abs(a - b).max(axis=-1) / max(scale, 1e-12), 0.0, 1.0) * 4.0
+    stops = np.array([[0, 0, 0], [0, 0, 1], [0, 1, 0], [1, 1, 0], [1, 0, 0]], np.float64)
+    i = np.minimum(t.astype(int), 3)
+    f = (t - i)[..., None]
+    return np.round((stops[i] * (1 - f) + stops[i + 1] * f) * 255).astype(np.uint8)
+
+
+def kinds(state: AppState):
+    if state.job_kinds is None:
+        state.job_kinds = available_jobs()
+    return state.job_kinds
+
+
+def start_job(state: AppState, index: int) -> None:
+    """Render the raster view to compare with (GL thread), then start the job's worker."""
+    kind = kinds(state)[index]
+    if kind.make is None:
+        state.error = f"{kind.label}: not available ({kind.reason})"
+        return
+    scene = clone_scene(state.scene)
+    if kind.label.startswith("Path"):
+        scene.raytrace.spp = state.job_spp
+    size = _job_size(state)
+    if state.gl is not None:
+        state.gl.draw_scene("job_raster", scene, size, kind.raster_shading, scene.render.specular)
+        state.job_raster = state.gl.read_linear("job_raster")
+        state.gl.restore()
+    state.job_kind, state.job_version, state.job_compare = index, -1, None
+    state.job_scene, state.job_size_px = scene, size
+    state.ray_tree = state.ray_tree_pixel = None
+    state.overlay_version += 1
+    state.job.start(kind.label, lambda: kind.make(scene, size), call=(kind.make, scene, size))
+
+
+def start_job_by_label(state: AppState, label: str) -> None:
+    for i, kind in enumerate(kinds(state)):
+        if kind.label.lower().startswith(label.lower()):
+            start_job(state, i)
+            return
+    state.error = f"--job '{label}': expected one of " + ", ".join(k.label for k in kinds(state))
+
+
+def _job_size(state: AppState) -> tuple[int, int]:
+    """The job's image: state.job_size pixels high, at the viewport's aspect ratio."""
+    w, h = state.viewport_size if state.viewport_size[1] > 0 else (1, 1)
+    height = state.job_size
+    return max(int(round(height * w / max(h, 1))), 1), height
+
+
+def _upload_results(state: AppState) -> None:
+    """Re-upload the job's image, its raster partner and their difference when new."""
+    latest, version = state.job.snapshot()
+    if latest is None or version == state.job_version:
+        return
+    state.job_version = version
+    _take_solution(state, latest)
+    if latest.image is None:
+        return
+    exposure = state.scene.render.exposure
+    image = np.asarray(latest.image, dtype=np.float32)
+    vp = state.gl
+    vp.upload_image("job_result", to_srgb8(image, exposure))
+    raster = state.job_raster
+    if raster is not None and raster.shape == image.shape:
+        vp.upload_image("job_raster", to_srgb8(raster, exposure))
+        scale = max(float(np.abs(raster).max()) * exposure, 1e-6) * 0.1
+        vp.upload_image("job_diff", heat_map(image * exposure, raster * exposure, scale))
+        state.job_compare = difference(image, raster) | {"heat_full_scale": scale / exposure}
+
+
+def _take_solution(state: AppState, latest) -> None:
+    """Keep a radiosity solution's display triangles (drawn in the viewport on request)."""
+    solution = latest.stats.get("solution") if latest.stats else None
+    if solution is not None and hasattr(solution, "display_meshes"):
+        from shadelab.ui.overlays import radiosity_soup
+
+        state.radiosity_soup = radiosity_soup(solution.display_meshes())
+        state.overlay_version += 1
+
+
+def _show(state: AppState, key: str, caption: str, width: float) -> tuple[int, int] | None:
+    """Show an uploaded image; returns the image pixel clicked, if any."""
+    tex = state.gl.images.get(key)
+    if tex is None:
+        return None
+    w, h = tex.size
+    imgui.begin_group()
+    origin = imgui.get_cursor_screen_pos()
+    imgui.image(imgui.ImTextureRef(tex.glo), imgui.ImVec2(width, width * h / w))
+    clicked = None
+    if imgui.is_item_clicked():
+        mouse = imgui.get_io().mouse_pos
+        x, y = int((mouse.x - origin.x) * w / width), int((mouse.y - origin.y) * w / width)
+        if 0 <= x < w and 0 <= y < h:
+            clicked = (x, y)
+    imgui.text(caption)
+    imgui.end_group()
+    return clicked
+
+
+def trace_tree(state: AppState, pixel: tuple[int, int]) -> None:
+    """The ray tree of a pixel of the ray-traced image, drawn in 3D in the viewport."""
+    try:
+        from shadelab.raytrace.tree import trace_pixel_tree
+    except ImportError as exc:
+        state.error = f"ray tree not available ({exc})"
+        return
+    try:
+        state.ray_tree = trace_pixel_tree(state.job_scene, state.job_size_px, *pixel)
+        state.ray_tree_pixel = pixel
+        state.overlay_version += 1
+    except Exception as exc:  # shown in the app; the session goes on
+        state.error = f"ray tree of pixel {pixel}: {exc}"
+
+
+def draw_ray_tree(state: AppState) -> None:
+    root = state.ray_tree
+    if root is None:
+        return
+    imgui.text(f"ray tree of pixel {state.ray_tree_pixel} (drawn in the viewport; "
+               f"total {_rgb(root.total())})")
+    if imgui.small_button("Clear ray tree"):
+        state.ray_tree = None
+        state.overlay_version += 1
+        return
+    flags = imgui.TableFlags_.borders | imgui.TableFlags_.row_bg | imgui.TableFlags_.scroll_y
+    if imgui.begin_table("raytree", 4, flags, imgui.ImVec2(0, 160)):
+        for head in ("ray", "hit", "weight", "contribution"):
+            imgui.table_setup_column(head)
+        imgui.table_headers_row()
+        for depth, node in root.flatten():
+            imgui.table_next_row()
+            imgui.table_next_column()
+            label = node.kind + (f" L{node.light} S={node.shadow:g}" if node.kind == "shadow"
+                                 else "")
+            imgui.text("  " * depth + label)
+            imgui.table_next_column()
+            imgui.text("miss" if node.end is None else f"object {node.object}")
+            imgui.table_next_column()
+            imgui.text(_rgb(node.weight))
+            imgui.table_next_column()
+            imgui.text(_rgb(node.contribution))
+        imgui.end_table()
+
+
+def _rgb(v) -> str:
+    return "(" + ", ".join(f"{float(c):.3g}" for c in np.asarray(v).reshape(-1)[:3]) + ")"
+
+
+def draw_offline_panel(state: AppState) -> bool:
+    """Pick a renderer, run it off the UI thread, compare its image with the raster view."""
+    job, options = state.job, kinds(state)
+    labels = [k.label + ("" if k.make else " (not available)") for k in options]
+    _, state.job_kind = imgui.combo("Renderer", state.job_kind, labels)
+    kind = options[state.job_kind]
+    if kind.make is None:
+        imgui.text_colored(panels.DIM_COLOR, f"not available: {kind.reason}")
+    index = SIZES.index(state.job_size) if state.job_size in SIZES else 3
+    _, index = imgui.combo("Height (px)", index, [str(s) for s in SIZES])
+    state.job_size = SIZES[index]
+    if kind.label.startswith("Path"):
+        index = SAMPLES.index(state.job_spp) if state.job_spp in SAMPLES else 0
+        _, index = imgui.combo("Samples / pixel", index, [str(n) for n in SAMPLES])
+        state.job_spp = SAMPLES[index]
+    imgui.begin_disabled(job.running or kind.make is None)
+    if imgui.button("Start"):
+        start_job(state, state.job_kind)
+    imgui.end_disabled()
+    imgui.same_line()
+    imgui.begin_disabled(not job.running)
+    if imgui.button("Cancel"):
+        job.cancel()
+    imgui.end_disabled()
+    latest, _ = job.snapshot()
+    if job.started:
+        fraction = latest.fraction if latest else 0.0
+        word = "running" if job.running else ("cancelled" if job.cancelled else "done")
+        if job.error:
+            word = "failed"
+        imgui.progress_bar(fraction, imgui.ImVec2(-1, 0),
+                           f"{job.name}: {word} {fraction * 100:.0f}%")
+        imgui.text(f"elapsed {job.elapsed:.1f} s   {latest.message if latest else ''}")
+    if job.error:
+        imgui.push_text_wrap_pos(0.0)
+        imgui.text_colored(panels.ERROR_COLOR, job.error)
+        imgui.pop_text_wrap_pos()
+    if state.gl is None:
+        return False
+    _upload_results(state)
+    width = (imgui.get_content_region_avail().x - 16) / 3
+    if "job_result" in state.gl.images and width > 8:
+        clicked = _show(state, "job_result", "offline (click: ray tree)"
+                        if kind.label.startswith("Whitted") else "offline", width)
+        if clicked is not None and kind.label.startswith("Whitted") and not job.running:
+            trace_tree(state, clicked)
+        imgui.same_line()
+        _show(state, "job_raster", f"raster ({kind.raster_shading})", width)
+        imgui.same_line()
+        _show(state, "job_diff", "|difference|", width)
+    if state.job_compare:
+        c = state.job_compare
+        imgui.text(f"RMSE {c['rmse']:.4g}  max |diff| {c['max_abs']:.4g}  "
+                   f"relative RMSE {c['relative_rmse']:.3%}")
+        imgui.text_colored(panels.DIM_COLOR, f"heat map: red = {c['heat_full_scale']:.3g}")
+    if latest is not None and latest.stats and not job.running:
+        shown = {k: v for k, v in latest.stats.items()
+                 if isinstance(v, (int, float, str, bool))}
+        imgui.text_wrapped("  ".join(f"{k}: {v:.4g}" if isinstance(v, float) else f"{k}: {v}"
+                                     for k, v in shown.items()))
+    if state.radiosity_soup is not None:
+        _, state.show_radiosity = imgui.checkbox("Show the radiosity solution in the viewport",
+                                                 state.show_radiosity)
+    draw_ray_tree(state)
+    return False

@@ -1,0 +1,302 @@
+"""The viewer's state: one dataclass, plus undo history and the autosaved session.
+
+Pure module (no GL, no GUI): the panels read and write an :class:`AppState`; the GL side keeps
+its resources elsewhere (:mod:`shadelab.ui.viewport`).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from shadelab.errors import ShadeLabError
+from shadelab.scene.model import Scene
+from shadelab.scene.preset import clone_scene, load_preset, save_preset, scene_to_dict
+
+COMPARE_VIEWS = (("flat", "phong"), ("gouraud", "phong"), ("phong", "phong"), ("phong", "blinn"))
+COMPARE_LABELS = ("Flat", "Gouraud", "Phong", "Blinn-Phong")
+HISTORY_LIMIT = 200          # undo snapshots kept
+AUTOSAVE_INTERVAL = 1.0      # seconds between autosaves of a changed scene
+
+
+class History:
+    """Undo/redo over Scene snapshots (one per finished edit, e.g. a slider release)."""
+
+    def __init__(self, scene: Scene):
+        self.snapshots = [clone_scene(scene)]
+        self.index = 0
+
+    def push(self, scene: Scene) -> None:
+        if scene_to_dict(scene) == scene_to_dict(self.snapshots[self.index]):
+            return  # nothing changed (e.g. a slider clicked but not moved)
+        del self.snapshots[self.index + 1:]
+        self.snapshots.append(clone_scene(scene))
+        if len(self.snapshots) > HISTORY_LIMIT:
+            self.snapshots.pop(0)
+        self.index = len(self.snapshots) - 1
+
+    def can_undo(self) -> bool:
+        return self.index > 0
+
+    def can_redo(self) -> bool:
+        return self.index < len(self.snapshots) - 1
+
+    def undo(self) -> Scene | None:
+        if not self.can_undo():
+            return None
+        self.index -= 1
+        return clone_scene(self.snapshots[self.index])
+
+    def redo(self) -> Scene | None:
+        if not self.can_redo():
+            return None
+        self.index += 1
+        return clone_scene(self.snapshots[self.index])
+
+
+# ---------------------------------------------------------------- autosaved session
+
+
+def state_dir() -> Path:
+    """``$XDG_STATE_HOME/shadelab`` (default ``~/.local/state/shadelab``)."""
+    base = os.environ.get("XDG_STATE_HOME") or str(Path.home() / ".local" / "state")
+    return Path(base) / "shadelab"
+
+
+def autosave_path() -> Path:
+    return state_dir() / "autosave.toml"
+
+
+def save_session(scene: Scene, source: str) -> Path:
+    """Write the scene and where it came from (preset name or file) to the state folder."""
+    folder = state_dir()
+    folder.mkdir(parents=True, exist_ok=True)
+    path = autosave_path()
+    save_preset(scene, path)
+    meta = {"source": source, "name": scene.name, "base_dir": scene.base_dir}
+    meta_path = path.with_suffix(".json")
+    tmp = meta_path.with_name(meta_path.name + ".tmp")
+    tmp.write_text(json.dumps(meta), encoding="utf-8")
+    tmp.replace(meta_path)
+    return path
+
+
+def load_session() -> tuple[Scene, str] | None:
+    """The autosaved scene and its source, or None when there is none (or it is unreadable)."""
+    path = autosave_path()
+    meta_path = path.with_suffix(".json")
+    if not path.is_file() or not meta_path.is_file():
+        return None
+    try:
+        meta = json.loads(meta_path.read_text(encoding="utf-8"))
+        scene = load_preset(str(path))
+    except (ShadeLabError, ValueError, OSError):
+        return None
+    scene.name = meta.get("name", "autosave")
+    scene.base_dir = meta.get("base_dir", scene.base_dir)
+    return scene, meta.get("source", scene.name)
+
+
+# ---------------------------------------------------------------- the app state
+
+
+@dataclass
+class AppState:
+    """Everything the panels show and edit; one instance per viewer window."""
+
+    scene: Scene
+    source: str                       # preset name or file the scene came from
+    saved: dict = field(default_factory=dict)      # scene_to_dict at the last load/save
+    initial_camera: Any = None        # the preset's camera, for "reset view"
+    history: History | None = None
+    # View options
+    show_wireframe: bool = False
+    show_normals: bool = False
+    normal_length: float = 0.04       # glyph length, share of the scene's diagonal
+    compare: bool = False
+    diff_enabled: bool = False
+    diff_pair: tuple[int, int] = (0, 2)   # indices into COMPARE_VIEWS
+    diff_scale: float = 0.2           # heat map: this difference (x exposure) is full red
+    presenter: bool = False
+    render_scale: float = 1.0         # scene resolution / viewport resolution
+    interactive_scale: float = 0.5    # the same while a slider or the camera is dragged
+    show_help: bool = False
+    legend_in_screenshot: bool = True
+    # Probe
+    probe_pixel: tuple[int, int] | None = None
+    probe: Any = None                 # shadelab.ui.probe.ProbeResult
+    probe_requested: bool = False
+    probe_version: int = 0            # bumped on every new probe result
+    # Messages
+    error: str = ""                   # shown in the app (bad preset, bad mesh...)
+    status: str = ""                  # last action ("saved ...", "screenshot ...")
+    # Files
+    preset_path: str = ""             # "Save" writes here
+    open_path: str = ""               # text field of the open/save box
+    screenshot_dir: str = "."
+    screenshot_requested: str = ""    # a path: the viewport is written there next frame
+    # Bookkeeping
+    dirty: bool = False               # unsaved changes (vs the preset or last save)
+    edit_pending: bool = False        # an edit not yet in the undo history
+    autosave_due: bool = False
+    frame: int = 0
+    viewport_size: tuple[int, int] = (0, 0)
+    job: Any = None                   # shadelab.ui.jobs.JobRunner
+    job_kind: int = 0
+    job_size: int = 128
+    job_spp: int = 16                 # samples per pixel (path tracer; Whitted anti-aliasing)
+    job_compare: Any = None           # dict of error figures vs the raster view
+    job_raster: Any = None            # (H, W, 3) raster image the job is compared with
+    job_kinds: Any = None             # shadelab.ui.jobs.available_jobs(), found on first use
+    job_version: int = -1             # the JobRunner version last uploaded
+    gl: Any = None                    # shadelab.ui.viewport.Viewport (GL thread only)
+    job_scene: Any = None             # the Scene snapshot the last job rendered
+    job_size_px: tuple = (0, 0)       # its image size (width, height)
+    ray_tree: Any = None              # shadelab.raytrace.tree.RayNode of a clicked traced pixel
+    ray_tree_pixel: Any = None        # (x, y) in the job image
+    radiosity_soup: Any = None        # (3F, 6) float32 solved display triangles (radiance)
+    show_radiosity: bool = False      # draw the radiosity solution instead of the raster
+    overlay_version: int = 0          # bumped when the ray tree or radiosity solution changes
+    # Studies and failure gallery panels (shadelab.ui.studies_panel)
+    study: Any = None                 # shadelab.ui.studies.StudyRun, made on first use
+    study_index: int = 0              # into shadelab.studies.STUDIES
+    study_chart: int = 0              # 0: the main chart; i: the result's i-th extra table
+    study_plotted: int = 0            # points the Studies chart drew last frame
+    study_budget: float = 0.01        # auto quality's error budget (relative MSE)
+    gallery_index: int = -1           # selected case of shadelab.studies.gallery.GALLERY
+    gallery_opened: str = ""          # name of the last case opened in the viewer
+
+    @classmethod
+    def from_scene(cls, scene: Scene, source: str, **kwargs) -> "AppState":
+        from shadelab.ui.jobs import JobRunner
+
+        state = cls(scene=scene, source=source, **kwargs)
+        state.saved = scene_to_dict(scene)
+        state.initial_camera = clone_scene(scene).camera
+        state.history = History(scene)
+        state.job = JobRunner()
+        return state
+
+    # ------------------------------------------------------------ edits
+    def mark_edited(self) -> None:
+        """A parameter changed this frame; it joins the undo history once the edit ends."""
+        self.edit_pending = True
+        self.autosave_due = True
+        self.probe_requested = self.probe_pixel is not None
+
+    def commit_edit(self) -> None:
+        """Close an edit: snapshot for undo, recompute the unsaved flag."""
+        self.edit_pending = False
+        self.probe_requested = self.probe_pixel is not None  # again, at full resolution
+        self.history.push(self.scene)
+        self.dirty = scene_to_dict(self.scene) != self.saved
+
+    def replace_scene(self, scene: Scene, source: str | None = None,
+                      new_file: bool = False) -> None:
+        """Show another scene (undo/redo keep the file; opening one resets everything)."""
+        self.scene = scene
+        if new_file:
+            self.source = source or scene.name
+            self.saved = scene_to_dict(scene)
+            self.initial_camera = clone_scene(scene).camera
+            self.history = History(scene)
+            self.probe_pixel, self.probe = None, None
+            self.preset_path = ""
+        self.dirty = scene_to_dict(scene) != self.saved
+        self.autosave_due = True
+        self.probe_requested = self.probe_pixel is not None
+
+    def undo(self) -> None:
+        scene = self.history.undo()
+        if scene is not None:
+            self.replace_scene(scene)
+            self.status = "undo"
+
+    def redo(self) -> None:
+        scene = self.history.redo()
+        if scene is not None:
+            self.replace_scene(scene)
+            self.status = "redo"
+
+    def open_file(self, path: str) -> bool:
+        """A preset (.toml or a name) replaces the scene; a mesh file is added to it."""
+        from shadelab.geometry.mesh import MESH_SUFFIXES
+
+        if Path(path).suffix.lower() in MESH_SUFFIXES:
+            return self.add_mesh(path)
+        return self.open_preset(path)
+
+    def add_mesh(self, path: str) -> bool:
+        """Add a mesh file as an object, fitted in front of the camera; errors keep the scene."""
+        import numpy as np
+
+        from shadelab.geometry.mesh import load_mesh_file
+        from shadelab.scene.model import Material, Object
+
+        key = f"objects.{len(self.scene.objects)}.path"
+        try:
+            mesh = load_mesh_file(str(Path(path).resolve()), ".", key)
+        except ShadeLabError as exc:
+            self.error = str(exc)
+            return False
+        cam = self.scene.camera
+        span = float(np.linalg.norm(np.subtract(cam.target, cam.eye)))
+        lo, hi = np.asarray(mesh.bounds, dtype=np.float64)
+        scale = 0.3 * span / max(float(np.max(hi - lo)), 1e-12)
+        offset = np.asarray(cam.target, dtype=np.float64) - scale * (lo + hi) / 2.0
+        if "mesh" not in self.scene.materials:
+            self.scene.materials["mesh"] = Material(ka=0.1, kd=0.7, ks=0.3, n=20.0)
+        self.scene.objects.append(Object(
+            shape="mesh", name=Path(path).stem, material="mesh", path=str(Path(path).resolve()),
+            scale=(scale,) * 3, translate=tuple(float(c) for c in offset), normals="angle"))
+        self.mark_edited()
+        self.commit_edit()
+        self.error, self.status = "", f"added mesh {path}"
+        return True
+
+    def open_preset(self, name_or_path: str) -> bool:
+        """Load a preset; on bad input show the error and keep the current scene."""
+        try:
+            scene = load_preset(name_or_path)
+            from shadelab.geometry.mesh import scene_meshes
+
+            scene_meshes(scene)  # mesh files must load too, before the scene is swapped
+        except ShadeLabError as exc:
+            self.error = str(exc)
+            return False
+        self.replace_scene(scene, name_or_path, new_file=True)
+        if name_or_path.endswith(".toml"):
+            self.preset_path = name_or_path
+        self.error, self.status = "", f"opened {name_or_path}"
+        return True
+
+    def save_as(self, path: str) -> bool:
+        """Save the scene as a preset file; errors are shown, nothing is half-written."""
+        if not path:
+            self.error = "save: enter a file name ending in .toml"
+            return False
+        if not path.endswith(".toml"):
+            path += ".toml"
+        try:
+            save_preset(self.scene, path)
+        except ShadeLabError as exc:
+            self.error = str(exc)
+            return False
+        self.preset_path = path
+        self.saved = scene_to_dict(self.scene)
+        self.dirty = False
+        self.error, self.status = "", f"saved {path}"
+        return True
+
+    def reset_view(self) -> None:
+        self.scene.camera = clone_scene(self.scene).camera if self.initial_camera is None \
+            else type(self.initial_camera)(**vars(self.initial_camera))
+        self.mark_edited()
+
+    def title(self) -> str:
+        """Window title: the preset, with a star while there are unsaved changes."""
+        name = self.scene.name or Path(self.source).stem
+        return f"ShadeLab - {name}{' *' if self.dirty else ''}"

@@ -1,0 +1,186 @@
+"""The viewer's GL side: scene passes into float targets, overlays, and the display pass.
+
+Works on any moderngl context (the viewer's window, or a headless one in tests). Every pane
+is a float RenderTarget (linear radiance) plus an RGBA8 texture that imgui shows.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import moderngl
+import numpy as np
+
+from shadelab.gl.programs import load_program, set_uniform
+from shadelab.gl.target import RenderTarget
+from shadelab.render.renderer import Renderer, View
+from shadelab.scene.camera import gl_matrix
+from shadelab.scene.model import Scene
+
+LINE_DEPTH_BIAS = 2e-4   # clip-space z pulled toward the eye for wireframe and glyphs
+
+
+@dataclass
+class Pane:
+    """One rendered view: float radiance, its display texture and the last camera."""
+
+    target: RenderTarget
+    display: moderngl.Texture
+    display_fbo: moderngl.Framebuffer
+    view: View | None = None
+
+    @property
+    def size(self) -> tuple[int, int]:
+        return self.target.size
+
+    def release(self) -> None:
+        self.display_fbo.release()
+        self.display.release()
+        self.target.release()
+
+
+class Viewport:
+    """Renders panes for the viewer (main view, compare views, heat map)."""
+
+    def __init__(self, ctx: moderngl.Context):
+        self.ctx = ctx
+        self.renderer = Renderer(ctx)
+        self.display_program = load_program(ctx, "display")
+        self.lines_program = load_program(ctx, "lines")
+        self.display_vao = ctx.vertex_array(self.display_program, [])
+        self.panes: dict[str, Pane] = {}
+        self.images: dict[str, moderngl.Texture] = {}  # CPU images (offline results)
+        self._anchor = ctx.simple_framebuffer((1, 1))
+        self._line_buffer = ctx.buffer(reserve=1 << 20, dynamic=True)
+        self._line_vao = ctx.vertex_array(self.lines_program,
+                                          [(self._line_buffer, "3f 3f", "in_position", "in_color")])
+
+    def restore(self) -> None:
+        """Bind the window's framebuffer again (imgui draws there), or a 1x1 anchor headless.
+
+        moderngl re-binds "the previous framebuffer" after creating one; it must never be a
+        framebuffer we have deleted, so one that outlives every pane is bound before releases.
+        """
+        (self.ctx.screen or self._anchor).use()
+
+    # ------------------------------------------------------------ panes
+    def pane(self, key: str, size: tuple[int, int]) -> Pane:
+        """The pane ``key`` at ``size`` (re-made when the size changes)."""
+        size = (max(int(size[0]), 1), max(int(size[1]), 1))
+        pane = self.panes.get(key)
+        if pane is not None and pane.size == size:
+            return pane
+        if pane is not None:
+            self.restore()
+            pane.release()
+        target = RenderTarget(self.ctx, size)
+        target.color.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        display = self.ctx.texture(size, 4, dtype="f1")
+        display.filter = (moderngl.LINEAR, moderngl.LINEAR)  # upscaled at render scale < 1
+        pane = Pane(target, display, self.ctx.framebuffer([display]))
+        self.panes[key] = pane
+        return pane
+
+    def draw_scene(self, key: str, scene: Scene, size: tuple[int, int], shading: str,
+                   specular: str) -> Pane:
+        """PASS 1-2 (the Renderer): the scene into the pane's float target."""
+        pane = self.pane(key, size)
+        pane.view = self.renderer.render(scene, pane.target, shading, specular)
+        return pane
+
+    def draw_colored_triangles(self, pane: Pane, scene: Scene, soup: np.ndarray) -> None:
+        """Per-vertex radiance triangles (a radiosity solution), Gouraud-interpolated."""
+        from shadelab.geometry.mesh import scene_meshes
+        from shadelab.render.renderer import make_view
+
+        pane.view = make_view(scene, pane.size, scene_meshes(scene))
+        pane.target.clear(scene.render.background)
+        self.draw_lines(pane, soup, 1.0, depth_test=True, mode=moderngl.TRIANGLES, bias=0.0)
+
+    def draw_lines(self, pane: Pane, lines: np.ndarray, exposure: float,
+                   depth_test: bool = True, mode: int = moderngl.LINES,
+                   bias: float = LINE_DEPTH_BIAS) -> None:
+        """Overlay colored segments (wireframe, glyphs, arrows) onto the float target."""
+        if len(lines) == 0 or pane.view is None:
+            return
+        data = np.ascontiguousarray(lines, dtype=np.float32).tobytes()
+        if len(data) > self._line_buffer.size:
+            self._line_buffer.orphan(len(data) * 2)
+        self._line_buffer.write(data)
+        pane.target.use()
+        self.ctx.enable_only(moderngl.DEPTH_TEST if depth_test else moderngl.NOTHING)
+        program = self.lines_program
+        set_uniform(program, "u_clip_from_world", gl_matrix(pane.view.clip_from_world))
+        set_uniform(program, "u_depth_bias", bias if depth_test else 0.0)
+        set_uniform(program, "u_scale", 1.0 / max(exposure, 1e-12))
+        self._line_vao.render(mode, vertices=len(lines))
+
+    def present(self, pane: Pane, exposure: float, source: Pane | None = None,
+                other: Pane | None = None, diff_scale: float = 0.05) -> moderngl.Texture:
+        """Display pass into ``pane``'s RGBA8 texture: exposure + sRGB of ``source`` (default
+        the pane itself), or the |source - other| heat map when ``other`` is given."""
+        source = source or pane
+        pane.display_fbo.use()
+        self.ctx.enable_only(moderngl.NOTHING)
+        source.target.color.use(0)
+        (other or source).target.color.use(1)
+        program = self.display_program
+        set_uniform(program, "t_image", 0)
+        set_uniform(program, "t_other", 1)
+        set_uniform(program, "u_mode", 1 if other is not None else 0)
+        set_uniform(program, "u_exposure", float(exposure))
+        set_uniform(program, "u_diff_scale", float(diff_scale))
+        self.display_vao.render(moderngl.TRIANGLES, vertices=3)
+        self.restore()
+        return pane.display
+
+    # ------------------------------------------------------------ read back
+    def read_pixel(self, key: str, pixel: tuple[int, int]) -> np.ndarray:
+        """Linear RGB the scene pass drew at (x, y), row 0 at the top (reads one pixel)."""
+        pane = self.panes[key]
+        x, y = pixel
+        raw = pane.target.fbo.read(viewport=(x, pane.size[1] - 1 - y, 1, 1), components=3,
+                                   dtype="f4")
+        self.restore()
+        return np.frombuffer(raw, dtype=np.float32).astype(np.float64)
+
+    def read_linear(self, key: str) -> np.ndarray:
+        return self.panes[key].target.read()
+
+    def read_display(self, key: str) -> np.ndarray:
+        """What the pane shows: (H, W, 3) uint8 sRGB, row 0 at the top."""
+        pane = self.panes[key]
+        w, h = pane.size
+        data = np.frombuffer(pane.display.read(), dtype=np.uint8).reshape(h, w, 4)
+        return np.ascontiguousarray(data[::-1, :, :3])
+
+    def upload_image(self, key: str, image_srgb8: np.ndarray) -> moderngl.Texture:
+        """A texture holding an (H, W, 3) uint8 image (row 0 at the top) for imgui.image."""
+        h, w = image_srgb8.shape[:2]
+        rgba = np.empty((h, w, 4), np.uint8)
+        rgba[..., :3], rgba[..., 3] = image_srgb8, 255
+        tex = self.images.get(key)
+        if tex is None or tex.size != (w, h):
+            if tex is not None:
+                tex.release()
+            tex = self.ctx.texture((w, h), 4, dtype="f1")
+            tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            self.images[key] = tex
+        tex.write(rgba.tobytes())  # row 0 first: imgui's default uv puts it on top
+        return tex
+
+    def release(self) -> None:
+        self.restore()
+        for pane in self.panes.values():
+            pane.release()
+        self.panes.clear()
+        for tex in self.images.values():
+            tex.release()
+        self._line_vao.release()
+        self._line_buffer.release()
+        self.display_vao.release()
+        self.display_program.release()
+        self.lines_program.release()
+        self.renderer.release()
+        (self.ctx.screen or self.ctx.detect_framebuffer(0)).use()
+        self._anchor.release()

@@ -1,3 +1,0 @@
-"""The lighting equation, once, in numpy (mirrored by shaders/include/lighting.glsl)."""
-
-from app.shading.reference import shade, shade_terms  # noqa: F401
