@@ -8,7 +8,8 @@ import sys
 import pytest
 
 PURE = ["shadelab.scene", "shadelab.scene.preset", "shadelab.scene.camera", "shadelab.shading",
-        "shadelab.shading.reference", "shadelab.geometry.mesh", "shadelab.geometry.normals", "shadelab.progress"]
+        "shadelab.shading.reference", "shadelab.geometry.mesh", "shadelab.geometry.normals",
+        "shadelab.progress"]
 OPTIONAL_PURE = ["shadelab.raytrace", "shadelab.radiosity", "shadelab.geometry.silhouette"]
 FORBIDDEN = ("moderngl", "glfw", "imgui_bundle", "OpenGL")
 

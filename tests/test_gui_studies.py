@@ -14,6 +14,7 @@ import sys
 from pathlib import Path
 
 import pytest
+
 from test_gui import _wait, run_scenario, xdisplay  # noqa: F401  (private Xvfb, helpers)
 
 ROOT = Path(__file__).resolve().parent.parent

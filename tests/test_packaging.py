@@ -33,7 +33,8 @@ def test_wheel_renders_from_any_directory(tmp_path):
     elsewhere.mkdir()
     env = {**os.environ, "PYTHONPATH": str(site)}
     out = subprocess.run([sys.executable, "-c",
-                          "import shadelab, sys; from shadelab.cli import main; print(shadelab.__file__); "
+                          "import shadelab, sys; from shadelab.cli import main; "
+                          "print(shadelab.__file__); "
                           "sys.exit(main(['render', 'cornell', '-o', 'x.png', "
                           "'--size', '32x32']))"],
                          cwd=elsewhere, env=env, capture_output=True, text=True)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from tests.golden import compare_golden
 
 from shadelab.geometry.mesh import scene_meshes
 from shadelab.render.offscreen import render_image
@@ -13,7 +14,6 @@ from shadelab.scene.model import Camera, Light, Material, Object, Scene
 from shadelab.scene.preset import list_presets, load_preset
 from shadelab.shading.conventions import to_srgb8
 from shadelab.shading.reference import shade
-from tests.golden import compare_golden
 
 pytestmark = pytest.mark.gl
 GOLDEN_SIZE = (160, 120)

@@ -108,7 +108,8 @@ def _fallback(corner: np.ndarray, fn: np.ndarray) -> np.ndarray:
 
 def corner_normals(vertices: np.ndarray, faces: np.ndarray, mode: str,
                    crease_angle_deg: float = 30.0) -> np.ndarray:
-    """Per-corner normals (F, 3, 3) for a normals mode of :data:`shadelab.scene.model.NORMALS_MODES`."""
+    """Per-corner normals (F, 3, 3) for a normals mode of
+    :data:`shadelab.scene.model.NORMALS_MODES`."""
     fn = face_normals(vertices, faces)
     if mode == "flat":
         return np.repeat(fn[:, None, :], 3, axis=1)

@@ -8,7 +8,8 @@ points are re-exported lazily (numba and embreex load on first use):
 
 from __future__ import annotations
 
-_LAZY = {"iter_radiosity": "shadelab.radiosity.solution", "solve_scene": "shadelab.radiosity.solution",
+_LAZY = {"iter_radiosity": "shadelab.radiosity.solution",
+         "solve_scene": "shadelab.radiosity.solution",
          "RadiositySolution": "shadelab.radiosity.solution"}
 
 

@@ -6,7 +6,8 @@ item buffer (``u4`` texture, ``flat out uint``), on the five faces of a hemicube
 frusta). Each pixel carries a delta form factor; F_ij sums those of the pixels showing j.
 Several patches share one atlas so that one read-back serves a batch.
 
-Imported lazily by :mod:`shadelab.radiosity.formfactors`: the radiosity package itself stays GL-free.
+Imported lazily by :mod:`shadelab.radiosity.formfactors`: the radiosity package itself stays
+GL-free.
 """
 
 from __future__ import annotations

@@ -20,7 +20,14 @@ from shadelab.progress import Progress
 from shadelab.radiosity import display
 from shadelab.radiosity.formfactors import FormFactors
 from shadelab.radiosity.patches import PatchSet, check_count, split_leaves, uniform_patches
-from shadelab.radiosity.solvers import SOLVERS, Step, check_solvable, new_history, record, run_solver
+from shadelab.radiosity.solvers import (
+    SOLVERS,
+    Step,
+    check_solvable,
+    new_history,
+    record,
+    run_solver,
+)
 from shadelab.scene.camera import primary_rays
 from shadelab.scene.model import Scene
 

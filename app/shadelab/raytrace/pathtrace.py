@@ -349,7 +349,9 @@ class TileJob:
 
     def __init__(self, scene: Scene, size: tuple[int, int], spp: int, seed: int,
                  backend: str, local: str):
-        from shadelab.scene.camera import camera_basis  # the camera's own frame, so the images align
+        from shadelab.scene.camera import (
+            camera_basis,  # the camera's own frame, so the images align
+        )
 
         self.tracer = PathTracer(scene, backend, local=local)
         self.size, self.spp, self.seed = size, spp, seed

@@ -23,7 +23,13 @@ from shadelab.scene.model import Camera
 from shadelab.ui import overlays, panels
 from shadelab.ui.offline import draw_offline_panel
 from shadelab.ui.probe import probe
-from shadelab.ui.state import AUTOSAVE_INTERVAL, COMPARE_LABELS, COMPARE_VIEWS, AppState, save_session
+from shadelab.ui.state import (
+    AUTOSAVE_INTERVAL,
+    COMPARE_LABELS,
+    COMPARE_VIEWS,
+    AppState,
+    save_session,
+)
 from shadelab.ui.studies_panel import draw_gallery_panel, draw_studies_panel
 
 ORBIT_SPEED = 0.008        # radians per pixel dragged
