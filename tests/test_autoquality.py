@@ -122,7 +122,6 @@ def test10_radiosity_auto_quality():
 
 @pytest.mark.parametrize("value", ["0", "-2", "inf"])
 def test11_radiosity_error_flag_bad_input(tmp_path, capsys, value):
-    pytest.importorskip("shadelab.radiosity.commands")
     code = main(["radiosity", "cornell", "-o", str(tmp_path / "r.png"), "--error", value])
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1 and "--error" in err

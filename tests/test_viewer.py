@@ -334,7 +334,7 @@ def test_view_restores_the_autosaved_session_unless_fresh_or_another_preset(tmp_
                                                                           monkeypatch, capsys):
     import argparse
 
-    from shadelab.ui.commands import load_scene
+    from shadelab.cli.view import load_scene
 
     monkeypatch.setenv("XDG_STATE_HOME", str(tmp_path / "xdg"))
     scene = load_preset("cornell")

@@ -8,7 +8,7 @@ import time
 
 import numpy as np
 
-from shadelab.bench import median_time
+from shadelab.timing import median_time
 from shadelab.raytrace.accel import BvhAccel, EmbreeAccel, embree_available, scene_geometry
 from shadelab.raytrace.pathtrace import PathTracer
 from shadelab.raytrace.surface import TraceContext

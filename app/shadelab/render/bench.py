@@ -9,7 +9,7 @@ import time
 import moderngl
 import numpy as np
 
-from shadelab.bench import median_time
+from shadelab.timing import median_time
 from shadelab.geometry.mesh import scene_meshes
 from shadelab.gl.context import create_headless_context, headless_context, make_current
 from shadelab.gl.programs import load_program, set_uniform

@@ -7,7 +7,7 @@ reports the shadow-volume geometry sizes and the other shadow presets for contex
 
 from __future__ import annotations
 
-from shadelab.bench import median_time
+from shadelab.timing import median_time
 from shadelab.gl.context import headless_context
 from shadelab.gl.target import RenderTarget
 from shadelab.render.renderer import Renderer

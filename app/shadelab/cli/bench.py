@@ -1,7 +1,7 @@
 """``shadelab bench``: performance figures as JSON (medians, with the machine).
 
-Each layer contributes a section module with ``run(quick: bool) -> dict``; a section whose
-module is not built yet is skipped. Speed is measured here, never asserted by a timed test.
+Each layer contributes a section module with ``run(quick: bool) -> dict`` (timed with
+:func:`shadelab.timing.median_time`). Speed is measured here, never asserted by a timed test.
 """
 
 from __future__ import annotations
@@ -11,10 +11,7 @@ import importlib
 import json
 import os
 import platform
-import statistics
 import sys
-import time
-from typing import Callable
 
 SECTIONS = (
     ("raster", "shadelab.render.bench"),
@@ -58,19 +55,6 @@ def machine() -> dict:
     return info
 
 
-def median_time(fn: Callable[[], object], repeats: int, warmup: int = 2) -> dict:
-    """Median, min and max wall time of ``fn`` in milliseconds."""
-    for _ in range(warmup):
-        fn()
-    samples = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        fn()
-        samples.append((time.perf_counter() - start) * 1000.0)
-    return {"median_ms": statistics.median(samples), "min_ms": min(samples),
-            "max_ms": max(samples), "repeats": repeats}
-
-
 def run(args: argparse.Namespace) -> int:
     if args.json:
         from shadelab.imageio import check_writable
@@ -86,12 +70,7 @@ def run(args: argparse.Namespace) -> int:
     for name, module_name in SECTIONS:
         if args.only and name not in args.only:
             continue
-        try:
-            module = importlib.import_module(module_name)
-        except ModuleNotFoundError as exc:
-            if exc.name and module_name.startswith(exc.name):
-                continue
-            raise
+        module = importlib.import_module(module_name)
         print(f"bench: {name} ...", file=sys.stderr, flush=True)
         report["sections"][name] = module.run(bool(args.quick))
     text = json.dumps(report, indent=2)

@@ -1,7 +1,8 @@
 """The ``shadelab`` command line (a stable contract; see README "Command line").
 
-Each subcommand lives in its layer as a module with ``add_parser(subparsers)`` and
-``run(args) -> int``; this file only dispatches. Bad input raises :class:`ShadeLabError`,
+The CLI is the top layer: each subcommand is a module of this package with
+``add_parser(subparsers)`` and ``run(args) -> int``; this file only dispatches. Nothing below
+imports this package. Bad input raises :class:`ShadeLabError`,
 printed here as one line, exit code 2.
 """
 
@@ -15,12 +16,12 @@ from shadelab.errors import ShadeLabError
 
 # Modules that contribute subcommands, in help order.
 COMMAND_MODULES = (
-    "shadelab.render.commands",
-    "shadelab.raytrace.commands",
-    "shadelab.radiosity.commands",
-    "shadelab.studies.commands",
-    "shadelab.bench",
-    "shadelab.ui.commands",
+    "shadelab.cli.render",
+    "shadelab.cli.raytrace",
+    "shadelab.cli.radiosity",
+    "shadelab.cli.studies",
+    "shadelab.cli.bench",
+    "shadelab.cli.view",
 )
 
 EXIT_BAD_INPUT = 2
@@ -39,13 +40,7 @@ def build_parser() -> argparse.ArgumentParser:
                                  "Run 'shadelab [PRESET]' to open the viewer (default: cornell).")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     for name in COMMAND_MODULES:
-        try:
-            module = importlib.import_module(name)
-        except ModuleNotFoundError as exc:
-            if exc.name and name.startswith(exc.name):  # a layer not built yet: no command
-                continue
-            raise
-        module.add_parser(sub)
+        importlib.import_module(name).add_parser(sub)
     return parser
 
 
