@@ -52,6 +52,14 @@ def _check_counts(depth: int | None, spp: int | None, workers: int | None = None
         raise ShadeLabError(f"--spp {spp}: expected an integer >= 1")
 
 
+MAX_SEED = 2**63 - 1
+
+
+def _check_seed(seed: int) -> None:
+    if not 0 <= seed <= MAX_SEED:
+        raise ShadeLabError(f"--seed {seed}: expected an integer in [0, 2**63 - 1]")
+
+
 def _check_scene(scene, preset: str) -> None:
     if not scene.objects:
         raise ShadeLabError(f"{preset}: objects: the scene is empty (expected at least one)")
@@ -99,6 +107,7 @@ def run_raytrace(args: argparse.Namespace) -> int:
 def run_pathtrace(args: argparse.Namespace) -> int:
     size = parse_size(args.size)
     _check_counts(None, args.spp, args.workers)
+    _check_seed(args.seed)
     scene = load_preset(args.preset, list(args.set))
     _check_scene(scene, args.preset)
     emitters = [o for o in scene.objects

@@ -33,8 +33,10 @@ def spec(default: Any, kind: str, *args: Any, doc: str = "") -> Any:
     """Declare a dataclass field with a validation spec.
 
     kind is one of ``float`` (min, max), ``int`` (min, max), ``bool``, ``str`` (choices or
-    None), ``rgb`` (three finite floats >= 0), ``rgb01`` (a reflectance color in [0, 1]),
-    ``vec3`` (three finite floats), ``vec3s`` (a list of vec3).
+    None), ``rgb`` (three floats in [0, max]), ``rgb01`` (a reflectance color in [0, 1]),
+    ``vec3`` (three floats in [min, max]), ``vec3s`` (a list of vec3, (min, max)).
+    Every number has a finite range (see the ``*_MAX`` constants), so no value a preset may
+    hold overflows a float64 computation or a float32 GPU buffer.
     """
     meta = {"spec": (kind, *args), "doc": doc}
     if isinstance(default, (list, dict)):
@@ -42,18 +44,25 @@ def spec(default: Any, kind: str, *args: Any, doc: str = "") -> Any:
     return field(default=default, metadata=meta)
 
 
-INF = float("inf")
+# The finite ranges every number of a preset lives in (decided once, here). A coordinate of
+# 1e9 world units is 1000 km in a millimetre scene; squared (1e18) and summed it stays far
+# from float32's 3.4e38, so shaders, Embree and numpy never overflow.
+LENGTH_MAX = 1e9  # coordinates, sizes, distances, world units
+SCALE_MAX = 1e6  # per-axis object scale (scale x size stays within 1e15)
+INTENSITY_MAX = 1e12  # Ip, Ia, emission, background: linear RGB
+COEFF_MAX = 1e12  # attenuation coefficients c1, c2, c3
+COORD = (-LENGTH_MAX, LENGTH_MAX)
 
 
 @dataclass
 class Camera:
     """A pinhole camera; ``fov_y`` is the full vertical field of view in degrees."""
 
-    eye: Point3 = spec((0.0, 1.0, 5.0), "vec3", doc="camera position, world units")
-    target: Point3 = spec((0.0, 0.0, 0.0), "vec3", doc="point looked at")
-    up: Vec3 = spec((0.0, 1.0, 0.0), "vec3", doc="up direction")
+    eye: Point3 = spec((0.0, 1.0, 5.0), "vec3", *COORD, doc="camera position, world units")
+    target: Point3 = spec((0.0, 0.0, 0.0), "vec3", *COORD, doc="point looked at")
+    up: Vec3 = spec((0.0, 1.0, 0.0), "vec3", *COORD, doc="up direction")
     fov_y: float = spec(45.0, "float", 1.0, 170.0, doc="vertical field of view, degrees")
-    near: float = spec(0.1, "float", 1e-6, INF, doc="near clipping distance, world units")
+    near: float = spec(0.1, "float", 1e-6, LENGTH_MAX, doc="near clipping distance, world units")
 
 
 @dataclass
@@ -67,13 +76,13 @@ class Light:
     kind: str = spec("point", "str", LIGHT_KINDS, doc="point | directional | spot")
     name: str = spec("", "str", None, doc="label shown in the viewer")
     enabled: bool = spec(True, "bool", doc="switch the light off without removing it")
-    position: Point3 = spec((0.0, 5.0, 0.0), "vec3", doc="point and spot lights")
-    direction: Vec3 = spec((0.0, -1.0, 0.0), "vec3", doc="directional and spot lights")
-    Ip: Rgb = spec((1.0, 1.0, 1.0), "rgb", doc="light intensity per RGB channel")
+    position: Point3 = spec((0.0, 5.0, 0.0), "vec3", *COORD, doc="point and spot lights")
+    direction: Vec3 = spec((0.0, -1.0, 0.0), "vec3", *COORD, doc="directional and spot lights")
+    Ip: Rgb = spec((1.0, 1.0, 1.0), "rgb", INTENSITY_MAX, doc="light intensity per RGB channel")
     attenuation: str = spec("none", "str", ATTENUATION_MODES, doc="none | inverse_square | lecture")
-    c1: float = spec(1.0, "float", 0.0, INF, doc="f_att constant term")
-    c2: float = spec(0.0, "float", 0.0, INF, doc="f_att linear term, per unit distance")
-    c3: float = spec(0.0, "float", 0.0, INF, doc="f_att quadratic term, per distance squared")
+    c1: float = spec(1.0, "float", 0.0, COEFF_MAX, doc="f_att constant term")
+    c2: float = spec(0.0, "float", 0.0, COEFF_MAX, doc="f_att linear term, per unit distance")
+    c3: float = spec(0.0, "float", 0.0, COEFF_MAX, doc="f_att quadratic term, per distance squared")
     cone_angle: float = spec(30.0, "float", 0.0, 90.0, doc="spot half-angle, degrees")
     spot_exponent: float = spec(1.0, "float", 0.0, 1000.0, doc="spot falloff, cos^e")
 
@@ -94,9 +103,10 @@ class Material:
     transparency: str = spec("interpolated", "str", TRANSPARENCY_MODELS, doc="raster model")
     kr: float = spec(-1.0, "float", -1.0, 1.0, doc="mirror reflection; -1 = use ks")
     ior: float = spec(1.5, "float", 1.0, 5.0, doc="index of refraction")
-    emission: Rgb = spec((0.0, 0.0, 0.0), "rgb", doc="emitted radiance (radiosity, path tracing)")
+    emission: Rgb = spec((0.0, 0.0, 0.0), "rgb", INTENSITY_MAX,
+                         doc="emitted radiance (radiosity, path tracing)")
     texture: str = spec("", "str", None, doc="'' | 'checker' | image path: modulates Od")
-    texture_scale: float = spec(8.0, "float", 1e-6, INF, doc="texture repeats across [0,1] uv")
+    texture_scale: float = spec(8.0, "float", 1e-6, 1e6, doc="texture repeats across [0,1] uv")
     texture_color2: Rgb = spec((0.1, 0.1, 0.1), "rgb01", doc="checker's second color")
     bump: str = spec("", "str", None, doc="'' | 'bumps' | height-map image path")
     bump_scale: float = spec(1.0, "float", 0.0, 100.0, doc="bump height scale")
@@ -116,18 +126,21 @@ class Object:
     name: str = spec("", "str", None, doc="label")
     material: str = spec("default", "str", None, doc="name of a [materials.X] table")
     path: str = spec("", "str", None, doc="mesh file (OBJ, PLY, STL, glTF/GLB), preset-relative")
-    radius: float = spec(1.0, "float", 1e-9, INF, doc="sphere, cylinder, cone, capsule, torus")
-    minor_radius: float = spec(0.25, "float", 1e-9, INF, doc="torus tube radius")
-    height: float = spec(1.0, "float", 1e-9, INF, doc="cylinder, cone, capsule")
-    extents: Vec3 = spec((1.0, 1.0, 1.0), "vec3", doc="box edge lengths")
-    size: float = spec(1.0, "float", 1e-9, INF, doc="plane edge length (xz plane, normal +y)")
-    vertices: list = spec([], "vec3s", doc="quad corners, counter-clockwise seen from the front")
+    radius: float = spec(1.0, "float", 1e-9, LENGTH_MAX,
+                         doc="sphere, cylinder, cone, capsule, torus")
+    minor_radius: float = spec(0.25, "float", 1e-9, LENGTH_MAX, doc="torus tube radius")
+    height: float = spec(1.0, "float", 1e-9, LENGTH_MAX, doc="cylinder, cone, capsule")
+    extents: Vec3 = spec((1.0, 1.0, 1.0), "vec3", *COORD, doc="box edge lengths")
+    size: float = spec(1.0, "float", 1e-9, LENGTH_MAX,
+                       doc="plane edge length (xz plane, normal +y)")
+    vertices: list = spec([], "vec3s", *COORD,
+                          doc="quad corners, counter-clockwise seen from the front")
     subdivisions: int = spec(3, "int", 0, 7, doc="sphere: icosphere subdivision level")
     sections: int = spec(32, "int", 3, 1024, doc="cylinder, cone, torus, capsule sections")
     segments: int = spec(1, "int", 1, 512, doc="plane and quad: cells per edge")
-    translate: Vec3 = spec((0.0, 0.0, 0.0), "vec3", doc="world offset")
-    rotate: Vec3 = spec((0.0, 0.0, 0.0), "vec3", doc="XYZ Euler angles, degrees")
-    scale: Vec3 = spec((1.0, 1.0, 1.0), "vec3", doc="per-axis scale")
+    translate: Vec3 = spec((0.0, 0.0, 0.0), "vec3", *COORD, doc="world offset")
+    rotate: Vec3 = spec((0.0, 0.0, 0.0), "vec3", *COORD, doc="XYZ Euler angles, degrees")
+    scale: Vec3 = spec((1.0, 1.0, 1.0), "vec3", -SCALE_MAX, SCALE_MAX, doc="per-axis scale")
     normals: str = spec("crease", "str", NORMALS_MODES, doc="vertex normal rule")
     crease_angle: float = spec(30.0, "float", 0.0, 180.0, doc="crease mode: split above, degrees")
     cast_shadows: bool = spec(True, "bool", doc="casts shadow volumes / blocks shadow rays")
@@ -143,7 +156,7 @@ class RenderSettings:
     shadow_method: str = spec("zfail", "str", ("zfail", "zpass"), doc="stencil counting")
     visibility: str = spec("zbuffer", "str", ("zbuffer", "painter"), doc="hidden surfaces")
     exposure: float = spec(1.0, "float", 0.0, 1e6, doc="scale applied before display")
-    background: Rgb = spec((0.0, 0.0, 0.0), "rgb", doc="clear color, linear")
+    background: Rgb = spec((0.0, 0.0, 0.0), "rgb", INTENSITY_MAX, doc="clear color, linear")
     show_volumes: bool = spec(False, "bool", doc="draw the shadow volumes, translucent")
     show_silhouettes: bool = spec(False, "bool", doc="highlight the casters' silhouette edges")
     stencil_heatmap: bool = spec(False, "bool", doc="overlay one light's stencil count")
@@ -157,7 +170,7 @@ class RaytraceSettings:
     depth: int = spec(5, "int", 0, 64, doc="maximum recursion depth")
     spp: int = spec(1, "int", 1, 65536, doc="samples per pixel (stratified)")
     min_weight: float = spec(0.01, "float", 0.0, 1.0, doc="stop a ray below this weight")
-    offset: float = spec(1e-3, "float", 0.0, INF, doc="ray origin offset, scene-relative")
+    offset: float = spec(1e-3, "float", 0.0, LENGTH_MAX, doc="ray origin offset, scene-relative")
     fresnel: bool = spec(False, "bool", doc="weight reflection/refraction by Fresnel")
 
 
@@ -178,7 +191,7 @@ class Scene:
     """Everything a renderer needs; ``base_dir`` resolves relative mesh and texture paths."""
 
     description: str = spec("", "str", None, doc="what this preset teaches")
-    Ia: Rgb = spec((0.1, 0.1, 0.1), "rgb", doc="ambient intensity")
+    Ia: Rgb = spec((0.1, 0.1, 0.1), "rgb", INTENSITY_MAX, doc="ambient intensity")
     camera: Camera = field(default_factory=Camera)
     lights: list[Light] = field(default_factory=list)
     materials: dict[str, Material] = field(default_factory=dict)

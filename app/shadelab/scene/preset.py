@@ -9,6 +9,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
+import reprlib
 import tomllib
 from pathlib import Path
 from typing import Any
@@ -29,6 +30,9 @@ from shadelab.scene.model import (
     RenderSettings,
     Scene,
 )
+
+MAX_PRESET_BYTES = 64 * 1024 * 1024  # a preset is text a person edits; 64 MiB is generous
+MAX_NESTING = 8  # deepest valid key: objects.N.vertices.M (4 levels); room for mistakes
 
 _SECTIONS = {
     "camera": Camera,
@@ -78,13 +82,69 @@ def load_preset(name_or_path: str, overrides: list[str] | None = None) -> Scene:
 
 def read_toml(path: Path) -> dict:
     try:
-        text = path.read_text(encoding="utf-8")
+        size = path.stat().st_size
+        if size > MAX_PRESET_BYTES:
+            raise ShadeLabError(f"{path}: preset is {size / 2**20:.0f} MiB, expected a TOML "
+                                f"text under {MAX_PRESET_BYTES // 2**20} MiB")
+        data = path.read_bytes()
     except OSError as exc:
         raise ShadeLabError(f"{path}: cannot read preset ({exc.strerror})") from None
+    return parse_toml(decode_text(data, str(path), "preset"), str(path))
+
+
+def decode_text(data: bytes, source: str, what: str = "file") -> str:
+    """UTF-8 text (a UTF-8 byte-order mark is allowed) or a one-line error saying what it is."""
+    if data.startswith((b"\xff\xfe", b"\xfe\xff")):
+        raise ShadeLabError(f"{source}: {what} is UTF-16 text; save it as UTF-8")
     try:
-        return tomllib.loads(text)
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = data.count(b"\n", 0, exc.start) + 1
+        column = exc.start - (data.rfind(b"\n", 0, exc.start) + 1) + 1
+        raise ShadeLabError(f"{source}: {what} is not UTF-8 text (byte 0x{data[exc.start]:02x} "
+                            f"at line {line}, column {column}); save it as UTF-8") from None
+    if "\x00" in text:
+        raise ShadeLabError(f"{source}: {what} is binary data, expected TOML text")
+    return text
+
+
+def parse_toml(text: str, source: str) -> dict:
+    """tomllib, with its recursion on deep nesting and any nesting past MAX_NESTING refused."""
+    try:
+        raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise ShadeLabError(f"{path}: TOML syntax error: {exc}") from None
+        raise ShadeLabError(f"{source}: TOML syntax error: {exc}") from None
+    except RecursionError:
+        raise ShadeLabError(f"{source}: arrays or tables nested too deeply "
+                            f"(expected at most {MAX_NESTING} levels)") from None
+    _check_nesting(raw, source)
+    return raw
+
+
+def _check_nesting(value: Any, source: str, limit: int = MAX_NESTING) -> None:
+    """Refuse containers nested deeper than ``limit`` (iterative: no recursion to exhaust)."""
+    stack = [(value, 0, "")]
+    while stack:
+        node, depth, where = stack.pop()
+        if depth > limit:
+            raise ShadeLabError(f"{source}: key '{where}': arrays or tables nested too deeply "
+                                f"(expected at most {limit} levels)")
+        if isinstance(node, dict):
+            stack.extend((v, depth + 1, f"{where}.{k}" if where else str(k))
+                         for k, v in node.items())
+        elif isinstance(node, list):
+            stack.extend((v, depth + 1, f"{where}.{i}" if where else str(i))
+                         for i, v in enumerate(node))
+
+
+_REPR = reprlib.Repr()
+_REPR.maxlevel, _REPR.maxlist, _REPR.maxstring, _REPR.maxother = 3, 6, 60, 60
+_REPR.maxdict = 4
+
+
+def _show(value: Any) -> str:
+    """A short repr for messages: a huge or deep value does not make a huge line."""
+    return _REPR.repr(value)
 
 
 def scene_from_dict(raw: dict, source: str = "<preset>") -> Scene:
@@ -149,18 +209,23 @@ def _field_spec(cls: type, key: str) -> tuple:
 
 def _number(value: Any, source: str, where: str, what: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ShadeLabError(f"{source}: key '{where}': expected {what}, got {value!r}")
-    if not math.isfinite(value):
-        raise ShadeLabError(f"{source}: key '{where}': expected {what}, got {value!r} (not finite)")
-    return float(value)
+        raise ShadeLabError(f"{source}: key '{where}': expected {what}, got {_show(value)}")
+    try:
+        out = float(value)  # an integer past 1.8e308 overflows here
+    except OverflowError:
+        out = math.inf
+    if not math.isfinite(out):
+        raise ShadeLabError(f"{source}: key '{where}': expected {what}, "
+                            f"got {_show(value)} (not finite)")
+    return out
 
 
-def _vec3(value: Any, source: str, where: str, what: str, minimum: float | None = None):
+def _vec3(value: Any, source: str, where: str, what: str, lo: float, hi: float):
     if not isinstance(value, (list, tuple)) or len(value) != 3:
-        raise ShadeLabError(f"{source}: key '{where}': expected {what}, got {value!r}")
+        raise ShadeLabError(f"{source}: key '{where}': expected {what}, got {_show(value)}")
     out = tuple(_number(v, source, where, what) for v in value)
-    if minimum is not None and min(out) < minimum:
-        raise ShadeLabError(f"{source}: key '{where}': expected {what}, got {value!r}")
+    if min(out) < lo or max(out) > hi:
+        raise ShadeLabError(f"{source}: key '{where}': expected {what}, got {_show(value)}")
     return out
 
 
@@ -172,39 +237,40 @@ def _check(cls: type, key: str, value: Any, source: str, where: str) -> Any:
         what = f"a number in [{lo:g}, {hi:g}]"
         out = _number(value, source, where, what)
         if not lo <= out <= hi:
-            raise ShadeLabError(f"{source}: key '{where}': expected {what}, got {value!r}")
+            raise ShadeLabError(f"{source}: key '{where}': expected {what}, got {_show(value)}")
         return out
     if kind == "int":
         lo, hi = args
         what = f"an integer in [{lo}, {hi}]"
         if isinstance(value, bool) or not isinstance(value, int) or not lo <= value <= hi:
-            raise ShadeLabError(f"{source}: key '{where}': expected {what}, got {value!r}")
+            raise ShadeLabError(f"{source}: key '{where}': expected {what}, got {_show(value)}")
         return int(value)
     if kind == "bool":
         if not isinstance(value, bool):
-            raise ShadeLabError(f"{source}: key '{where}': expected true or false, got {value!r}")
+            raise ShadeLabError(f"{source}: key '{where}': expected true or false, "
+                                f"got {_show(value)}")
         return value
     if kind == "str":
         (choices,) = args
         if not isinstance(value, str) or (choices and value not in choices):
             expected = " | ".join(choices) if choices else "a string"
-            raise ShadeLabError(f"{source}: key '{where}': expected {expected}, got {value!r}")
+            raise ShadeLabError(f"{source}: key '{where}': expected {expected}, got {_show(value)}")
         return value
     if kind == "rgb":
-        return _vec3(value, source, where, "three numbers >= 0 (linear RGB)", minimum=0.0)
+        (hi,) = args
+        return _vec3(value, source, where, f"three numbers in [0, {hi:g}] (linear RGB)", 0.0, hi)
     if kind == "rgb01":
-        out = _vec3(value, source, where, "three numbers in [0, 1] (a reflectance color)",
-                    minimum=0.0)
-        if max(out) > 1.0:
-            raise ShadeLabError(f"{source}: key '{where}': expected three numbers in [0, 1] "
-                                f"(a reflectance color), got {value!r}")
-        return out
+        return _vec3(value, source, where, "three numbers in [0, 1] (a reflectance color)",
+                     0.0, 1.0)
     if kind == "vec3":
-        return _vec3(value, source, where, "three finite numbers")
+        lo, hi = args
+        return _vec3(value, source, where, f"three numbers in [{lo:g}, {hi:g}]", lo, hi)
     if kind == "vec3s":
+        lo, hi = args
+        what = f"a list of [x, y, z] points, each number in [{lo:g}, {hi:g}]"
         if not isinstance(value, list):
-            raise ShadeLabError(f"{source}: key '{where}': expected a list of [x, y, z] points")
-        return [_vec3(v, source, where, "a list of [x, y, z] points") for v in value]
+            raise ShadeLabError(f"{source}: key '{where}': expected {what}")
+        return [_vec3(v, source, where, what, lo, hi) for v in value]
     raise AssertionError(kind)
 
 
@@ -248,12 +314,17 @@ def parse_value(text: str) -> Any:
     if "," in text and not text.startswith("["):
         return [parse_value(part) for part in text.split(",")]
     try:
-        return tomllib.loads(f"v = {text}")["v"]
+        value = tomllib.loads(f"v = {text}")["v"]
+    except RecursionError:
+        raise ShadeLabError(f"--set value '{text[:40]}...': arrays or tables nested too deeply "
+                            f"(expected at most {MAX_NESTING} levels)") from None
     except tomllib.TOMLDecodeError:
         lowered = text.lower()
         if lowered in ("nan", "+nan", "-nan", "inf", "+inf", "-inf"):
             return float(lowered)
         return text
+    _check_nesting(value, "--set value")
+    return value
 
 
 def apply_override(raw: dict, item: str, source: str = "--set") -> None:
@@ -290,7 +361,7 @@ def _descend(node: Any, part: str, path: list[str], source: str) -> Any:
 
 
 def _index(node: list, part: str, path: list[str], source: str) -> int:
-    if not part.isdigit() or int(part) >= len(node):
+    if not (part.isascii() and part.isdigit()) or int(part) >= len(node):
         raise ShadeLabError(f"--set '{'.'.join(path)}': expected an index below {len(node)} "
                             f"in {source}")
     return int(part)

@@ -44,13 +44,13 @@ def _field_schema(spec: tuple) -> dict:
     if kind == "str":
         return {"type": "string", "enum": list(args[0])} if args[0] else {"type": "string"}
     if kind == "rgb":
-        return {**vec, "items": {"type": "number", "minimum": 0}}
+        return {**vec, "items": _number(0.0, args[0])}
     if kind == "rgb01":
         return {**vec, "items": {"type": "number", "minimum": 0, "maximum": 1}}
     if kind == "vec3":
-        return vec
+        return {**vec, "items": _number(*args)}
     if kind == "vec3s":
-        return {"type": "array", "items": vec}
+        return {"type": "array", "items": {**vec, "items": _number(*args)}}
     raise AssertionError(kind)
 
 
