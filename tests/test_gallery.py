@@ -175,10 +175,10 @@ def test08_total_internal_reflection():
 def test09_hemicube_aliasing(gl_ctx):
     """A patch smaller than a hemicube pixel: at 8 px its form factor jumps between missing
     (-100 %) and +50 % as it slides by sub-pixel steps; at 256 px it stays within 5 %."""
-    pytest.importorskip("shadelab.radiosity.hemicube_gl")
+    hemicube = pytest.importorskip("shadelab.render.hemicube")
     gallery = pytest.importorskip("shadelab.radiosity.gallery")
     _case_scene("hemicube-aliasing")
-    out = gallery.hemicube_aliasing((8, 256))
+    out = gallery.hemicube_aliasing((8, 256), hemicube=hemicube.Hemicube)
     # Known: the GL hemicube leaves GL_INVALID_OPERATION behind (reported to its owner);
     # read it here so that later tests on the shared context start clean.
     _ = gl_ctx.error

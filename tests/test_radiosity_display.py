@@ -115,8 +115,8 @@ def test06_gl_image_matches_cpu_and_aligns_with_raster(gl_ctx):
     """Cornell (the open front shows background): the GL program draws the same triangles as
     the CPU rays, equal to 1e-5 relative away from silhouettes (99 % of pixels); the
     coverage equals the raster renderer's pixel for pixel (same camera matrices)."""
-    from shadelab.radiosity.display_gl import render_solution
     from shadelab.render.offscreen import render_image
+    from shadelab.render.radiosity_image import render_solution
 
     scene = load_preset("cornell")
     solution = _solve(scene, uniform_patches(scene, 60))

@@ -120,10 +120,13 @@ def test07_rows_on_demand_and_the_reciprocal_matrix(box_patches):
 def test08_hemicube_unit_squares(gl_ctx, squares):
     """A 256^2 hemicube at 3x3 Gauss points per receiver: within 2 % (the issue's bound).
     (One hemicube at the centre measures the point factor instead: 0.239, +20 %.)"""
-    F = FormFactors(squares, "hemicube", resolution=256, hemicube_samples=9).matrix()
+    from shadelab.render.hemicube import Hemicube
+
+    F = FormFactors(squares, "hemicube", resolution=256, hemicube_samples=9,
+                    hemicube=Hemicube).matrix()
     assert F[0, 1] == pytest.approx(PARALLEL, rel=0.02)
     assert F[0, 2] == pytest.approx(PERPENDICULAR, rel=0.02)
-    centre = FormFactors(squares, "hemicube", resolution=256).matrix()
+    centre = FormFactors(squares, "hemicube", resolution=256, hemicube=Hemicube).matrix()
     assert centre[0, 1] == pytest.approx(point_polygon([0.5, 0.5, 0], [0, 0, 1], OPPOSITE),
                                          rel=0.01)
 
@@ -132,7 +135,9 @@ def test08_hemicube_unit_squares(gl_ctx, squares):
 def test09_hemicube_closed_box(gl_ctx, box_patches):
     """Row sums 1 within 1 % (pixels cover the whole hemisphere); agrees with ray-cast
     within 0.01 per entry at 128^2 (patches are small next to their distances)."""
-    F = FormFactors(box_patches, "hemicube", resolution=128).matrix()
+    from shadelab.render.hemicube import Hemicube
+
+    F = FormFactors(box_patches, "hemicube", resolution=128, hemicube=Hemicube).matrix()
     np.testing.assert_allclose(F.sum(axis=1), 1.0, atol=0.01)
     ray = form_factor_matrix(box_patches, "raycast")
     far = ~np.isclose(box_patches.normals @ box_patches.normals.T, 0.0)  # not perpendicular
@@ -142,7 +147,7 @@ def test09_hemicube_closed_box(gl_ctx, box_patches):
 @pytest.mark.gl
 def test10_item_images_of_a_patch(gl_ctx, box_patches):
     """The teaching images: ids on the 5 faces; summing delta factors per id gives the row."""
-    from shadelab.radiosity.hemicube_gl import Hemicube
+    from shadelab.render.hemicube import Hemicube
 
     cube = Hemicube(box_patches, 32)
     images = cube.item_images(3)
@@ -155,3 +160,14 @@ def test10_item_images_of_a_patch(gl_ctx, box_patches):
     row[3] = 0.0
     np.testing.assert_allclose(row, images["row"], atol=1e-12)
     cube.release()
+
+
+def test11_hemicube_without_a_backend_is_refused(squares):
+    """The radiosity layer imports no GL: hemicube form factors need the backend passed in."""
+    from shadelab.errors import ShadeLabError
+    from shadelab.radiosity.solution import iter_radiosity
+
+    with pytest.raises(ShadeLabError, match="hemicube=shadelab.render.hemicube.Hemicube"):
+        FormFactors(squares, "hemicube")
+    with pytest.raises(ShadeLabError, match="GPU backend"):
+        next(iter_radiosity(load_preset("cornell"), None, 20, "hemicube"))

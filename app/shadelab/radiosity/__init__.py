@@ -1,7 +1,8 @@
 """Radiosity: patches, form factors (hemicube, ray-cast, analytic), solvers, Gouraud display.
 
-Pure layer: no GL at import. The GPU hemicube (:mod:`shadelab.radiosity.hemicube_gl`) and the GL
-image (:mod:`shadelab.radiosity.display_gl`) are imported only when asked for. The main entry
+Pure layer: no GL anywhere. The GPU hemicube (:mod:`shadelab.render.hemicube`) is passed in as
+a backend (``hemicube=Hemicube``); the GL image is :mod:`shadelab.render.radiosity_image`, and
+:mod:`shadelab.render.radiosity` binds the two to the solver. The main entry
 points are re-exported lazily (numba and embreex load on first use):
 ``iter_radiosity``, ``solve_scene``, ``RadiositySolution`` (``shadelab.radiosity.solution``).
 """

@@ -12,8 +12,8 @@ Three ways, as in the lecture and the literature:
   points on the source decide visibility (embreex), each ray weighted by Wallace's disk term
   ``cos_i cos_j dA / (pi r^2 + dA)``. The visible share multiplies the exact unoccluded
   kernel at that point, so an unoccluded pair is exact and an occluded one is sampled.
-* ``hemicube`` -- Cohen & Greenberg 1985 on the GPU: :mod:`shadelab.radiosity.hemicube_gl`
-  (imported lazily; this module stays GL-free).
+* ``hemicube`` -- Cohen & Greenberg 1985 on the GPU. This module stays GL-free: the caller
+  passes the backend, ``FormFactors(..., hemicube=shadelab.render.hemicube.Hemicube)``.
 
 Rows are computed on demand (:class:`FormFactors`), so progressive refinement can start
 shooting before the whole matrix exists, as it did in Cohen et al. 1988.
@@ -27,43 +27,20 @@ from typing import Iterator
 import numba
 import numpy as np
 
+from shadelab.errors import ShadeLabError
 from shadelab.radiosity.patches import PatchSet
+from shadelab.radiosity.sampling import (  # noqa: F401  (re-exported)
+    GAUSS_ORDER,
+    SOURCE_GRID,
+    bilinear_samples,
+    hemicube_delta_factors,
+    receiver_samples,
+    source_samples,
+)
 
 METHODS = ("hemicube", "raycast", "analytic")
-GAUSS_ORDER = 2  # receiver quadrature: 2x2 Gauss-Legendre points per patch (3: 0.01 % on
-#                  the unit squares, 2: 0.7 %, at less than half the cost)
-SOURCE_GRID = 4  # source sample points per edge (4x4) that visibility rays aim at
 RAYS_PER_POINT = 4  # visibility rays from each receiver point
 MAX_RAYS_PER_BATCH = 2_000_000  # bounds memory: rows are processed in blocks
-
-
-# ---------------------------------------------------------------------- sample points
-def bilinear_samples(polygons: np.ndarray, t: np.ndarray, w: np.ndarray):
-    """Points (N, K, 3) and area weights (N, K) summing to 1 on each (N, 4, 3) polygon.
-
-    ``t``, ``w`` are 1-D rule nodes in [0, 1] and weights; the bilinear Jacobian makes the
-    rule exact for area and handles triangles (a repeated corner) too.
-    """
-    u, v = np.meshgrid(t, t, indexing="ij")
-    u, v = u.reshape(-1), v.reshape(-1)
-    weight = np.outer(w, w).reshape(-1)
-    p0, p1, p2, p3 = (polygons[:, k, None, :] for k in range(4))
-    uu, vv = u[None, :, None], v[None, :, None]
-    points = (1 - uu) * (1 - vv) * p0 + uu * (1 - vv) * p1 + uu * vv * p2 + (1 - uu) * vv * p3
-    du = (1 - vv) * (p1 - p0) + vv * (p2 - p3)
-    dv = (1 - uu) * (p3 - p0) + uu * (p2 - p1)
-    jac = np.linalg.norm(np.cross(du, dv), axis=-1) * weight[None, :]
-    return points, jac / np.maximum(jac.sum(axis=1, keepdims=True), 1e-300)
-
-
-def receiver_samples(polygons: np.ndarray, order: int = GAUSS_ORDER):
-    g, w = np.polynomial.legendre.leggauss(order)
-    return bilinear_samples(polygons, (g + 1.0) / 2.0, w / 2.0)
-
-
-def source_samples(polygons: np.ndarray, grid: int = SOURCE_GRID):
-    t = (np.arange(grid) + 0.5) / grid
-    return bilinear_samples(polygons, t, np.full(grid, 1.0 / grid))
 
 
 # ---------------------------------------------------------------------- kernels
@@ -261,13 +238,17 @@ class FormFactors:
     rays : visibility rays per receiver point (raycast)
     hemicube_samples : hemicubes per patch, 1 (centre) or 9 (3x3 Gauss points)
     order : receiver quadrature, order x order Gauss-Legendre points (raycast, analytic)
+    hemicube : the GPU backend for ``method="hemicube"``: a factory
+        ``hemicube(patches, resolution, samples)`` of an object with ``rows(indices)`` and
+        ``release()``, e.g. :class:`shadelab.render.hemicube.Hemicube` (required for hemicube)
     """
 
     def __init__(self, patches: PatchSet, method: str = "raycast", resolution: int = 128,
                  rays: int = RAYS_PER_POINT, hemicube_samples: int = 1,
-                 order: int = GAUSS_ORDER):
+                 order: int = GAUSS_ORDER, hemicube=None):
         if method not in METHODS:
             raise ValueError(f"form factor method {method!r}: expected one of {METHODS}")
+        check_backend(method, hemicube)
         self.patches = patches
         self.method = method
         self.resolution = int(resolution)
@@ -280,6 +261,7 @@ class FormFactors:
         self._recv, self._recv_w = receiver_samples(patches.polygons, order)
         self._src, self._src_w = None, None
         self._embree = None
+        self._hemicube_factory = hemicube
         self._hemicube = None
         self._occluder_data = None
 
@@ -405,10 +387,17 @@ class FormFactors:
 
     def _hemicube_rows(self, rows: np.ndarray) -> np.ndarray:
         if self._hemicube is None:
-            from shadelab.radiosity.hemicube_gl import Hemicube  # GL only when asked for
-
-            self._hemicube = Hemicube(self.patches, self.resolution, self.hemicube_samples)
+            self._hemicube = self._hemicube_factory(self.patches, self.resolution,
+                                                    self.hemicube_samples)
         return self._hemicube.rows(rows)
+
+
+def check_backend(method: str, hemicube) -> None:
+    """Refuse ``method="hemicube"`` without a GPU backend (this layer imports no GL)."""
+    if method == "hemicube" and hemicube is None:
+        raise ShadeLabError("hemicube form factors need a GPU backend: pass "
+                            "hemicube=shadelab.render.hemicube.Hemicube (or use "
+                            "form_factors='raycast')")
 
 
 def order_sq(ff: FormFactors) -> int:
@@ -446,21 +435,3 @@ def point_polygon(x, n, polygon) -> float:
         poly = poly[[0, 1, 2, 2]]
     return float(_point_polygon(np.asarray(x, float), np.asarray(n, float), poly, 0.0,
                                 np.empty((8, 3))))
-
-
-def hemicube_delta_factors(resolution: int) -> tuple[np.ndarray, np.ndarray]:
-    """Delta form factors of a hemicube: top (res, res) and one side (res // 2, res).
-
-    Top face at z = 1, cells of side 2 / res: dF = dA / (pi (x^2 + y^2 + 1)^2). Side face
-    x = 1, upper half z in (0, 1): dF = z dA / (pi (y^2 + z^2 + 1)^2). Side rows run from
-    z near 1 (row 0) down to the horizon. Top + 4 sides sum to 1 (up to discretization).
-    """
-    res = int(resolution)
-    c = -1.0 + (np.arange(res) + 0.5) * (2.0 / res)
-    da = (2.0 / res) ** 2
-    x, y = np.meshgrid(c, c, indexing="xy")
-    top = da / (np.pi * (x * x + y * y + 1.0) ** 2)
-    z = c[res // 2:][::-1]
-    yy, zz = np.meshgrid(c, z, indexing="xy")
-    side = zz * da / (np.pi * (yy * yy + zz * zz + 1.0) ** 2)
-    return top, side

@@ -8,19 +8,18 @@
 * T-vertex cracks: adaptive subdivision puts fine corners in the middle of coarse edges;
   drawn naively the two sides interpolate different values along that edge.
 
-``python -m shadelab.radiosity.gallery OUTDIR`` writes the pictures (item images need EGL).
+The pictures (GL) are written by ``python -m shadelab.render.radiosity OUTDIR``; this module
+stays GL-free, so the hemicube backend is passed in (``hemicube_aliasing(hemicube=...)``).
 """
 
 from __future__ import annotations
 
 import copy
-import sys
-from pathlib import Path
 
 import numpy as np
 
 from shadelab.radiosity.display import crack_report
-from shadelab.radiosity.formfactors import FormFactors, point_polygon
+from shadelab.radiosity.formfactors import FormFactors, check_backend, point_polygon
 from shadelab.radiosity.patches import from_polygons, uniform_patches
 from shadelab.radiosity.solution import RadiositySolution, _solve_quick, mesh_scene
 from shadelab.scene.model import Object, Scene
@@ -39,18 +38,21 @@ def small_patch_scene(side: float, shift: float) -> tuple:
     return from_polygons([receiver, small]), np.asarray(small, float)
 
 
-def hemicube_aliasing(resolutions=(8, 256), side: float = 0.2, shifts=None) -> dict:
+def hemicube_aliasing(resolutions=(8, 256), side: float = 0.2, shifts=None,
+                      hemicube=None) -> dict:
     """F from the receiver's centre to a small square, by hemicube at each resolution, for
-    several sub-pixel shifts, against the exact point-to-polygon value (GL)."""
-    from shadelab.radiosity.hemicube_gl import Hemicube
+    several sub-pixel shifts, against the exact point-to-polygon value.
 
+    ``hemicube``: the GPU backend (:class:`shadelab.render.hemicube.Hemicube`), required.
+    """
+    check_backend("hemicube", hemicube)
     shifts = np.linspace(0.0, 1.0, 9) if shifts is None else np.asarray(shifts)
     out = {"shifts": shifts, "exact": [], "hemicube": {int(r): [] for r in resolutions}}
     for shift in shifts:
         patches, small = small_patch_scene(side, float(shift))
         out["exact"].append(point_polygon([0, 0, 0], [0, 0, 1], small))
         for res in resolutions:
-            cube = Hemicube(patches, int(res))
+            cube = hemicube(patches, int(res))
             out["hemicube"][int(res)].append(float(cube.rows(np.array([0]))[0, 1]))
             cube.release()
     out["exact"] = np.asarray(out["exact"])
@@ -123,45 +125,3 @@ def t_vertex_cracks(count: int = 120, preset: str = "radiosity-leak") -> dict:
     report = crack_report(patches, solution.radiance)
     report["solution"] = solution
     return report
-
-
-# ---------------------------------------------------------------------- pictures
-def write_gallery(folder: str, size: tuple[int, int] = (256, 256)) -> list[str]:
-    """Write the gallery's pictures (PNG) into ``folder``; returns the paths."""
-    from shadelab.imageio import write_png
-    from shadelab.radiosity.display_gl import render_solution
-    from shadelab.radiosity.hemicube_gl import item_images
-
-    out = Path(folder)
-    out.mkdir(parents=True, exist_ok=True)
-    written = []
-    leak = light_leak()
-    for name in ("unsplit", "split"):
-        path = out / f"leak_{name}.png"
-        write_png(str(path), render_solution(leak[f"{name}_solution"], size))
-        written.append(str(path))
-    cracks = t_vertex_cracks()
-    for conforming in (False, True):
-        path = out / f"tvertex_{'conforming' if conforming else 'naive'}.png"
-        write_png(str(path), render_solution(cracks["solution"], size, conforming))
-        written.append(str(path))
-    for res in (8, 64):
-        patches, _ = small_patch_scene(0.2, 0.5)
-        images = item_images(patches, 0, res)
-        path = out / f"hemicube_items_{res}.png"
-        top = (images["top"] >= 0).astype(np.float32)
-        write_png(str(path), np.repeat(np.kron(top, np.ones((256 // res, 256 // res)))[..., None],
-                                       3, axis=2))
-        written.append(str(path))
-    return written
-
-
-def main(argv: list[str]) -> int:
-    folder = argv[0] if argv else "gallery"
-    for path in write_gallery(folder):
-        print(path)
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))

@@ -4,6 +4,9 @@
 same job as a progressive generator of :class:`shadelab.progress.Progress` for the viewer's side
 panel and the CLI's progress bar. Units (DESIGN.md §2): rho = kd * Od, E = pi * Le,
 B = pi * L; images and ``display_meshes`` hold radiance L = B / pi.
+
+This layer imports no GL: hemicube form factors need the GPU backend passed in, as
+``hemicube=shadelab.render.hemicube.Hemicube`` (:mod:`shadelab.render.radiosity` binds it).
 """
 
 from __future__ import annotations
@@ -18,7 +21,7 @@ import numpy as np
 from shadelab.errors import ShadeLabError
 from shadelab.progress import Progress
 from shadelab.radiosity import display
-from shadelab.radiosity.formfactors import FormFactors
+from shadelab.radiosity.formfactors import FormFactors, check_backend
 from shadelab.radiosity.patches import PatchSet, check_count, split_leaves, uniform_patches
 from shadelab.radiosity.solvers import (
     SOLVERS,
@@ -56,11 +59,13 @@ class RadiositySolution:
     stats: dict = field(default_factory=dict)
     form_factors: FormFactors | None = None  # the rows computed so far (heat map, teaching)
 
-    def form_factor_matrix(self) -> np.ndarray:
-        """(N, N) F of this solution's patches (computed now where rows are missing)."""
+    def form_factor_matrix(self, hemicube=None) -> np.ndarray:
+        """(N, N) F of this solution's patches (computed now where rows are missing;
+        ``hemicube``: the GPU backend, needed only for a hemicube solution without rows)."""
         if self.form_factors is None:
             self.form_factors = FormFactors(self.patches, self.stats.get("form_factors",
-                                                                         "raycast"))
+                                                                         "raycast"),
+                                            hemicube=hemicube)
         return self.form_factors.matrix()
 
     @property
@@ -117,14 +122,16 @@ def _rho_names(scene: Scene, patches: PatchSet) -> str:
 
 # ---------------------------------------------------------------------- meshing
 def mesh_scene(scene: Scene, count: int, method: str = "raycast", adaptive: bool = True,
-               resolution: int = 128) -> PatchSet:
+               resolution: int = 128, hemicube=None) -> PatchSet:
     """Patches for the scene: uniform, or refined where the radiosity changes fast.
 
     Adaptive meshing solves a coarser mesh (``REFINE_SHARE`` of ``count``), splits the leaves
     whose corner radiances differ most from their own (shadow edges, corners) and repeats;
     leaves in flat regions stay as they are, so the result may have fewer than ``count``.
+    ``hemicube``: the GPU backend when ``method`` is "hemicube" (see :class:`FormFactors`).
     """
     count = check_count(count)
+    check_backend(method, hemicube)
     if not adaptive or count < 8:
         return uniform_patches(scene, count)
     patches = uniform_patches(scene, max(1, int(count * REFINE_SHARE)))
@@ -134,7 +141,7 @@ def mesh_scene(scene: Scene, count: int, method: str = "raycast", adaptive: bool
         splits = (budget - len(patches)) // 3
         if splits <= 0:
             break
-        F = FormFactors(patches, method, resolution).matrix()
+        F = FormFactors(patches, method, resolution, hemicube=hemicube).matrix()
         check_solvable(F, patches.rho, lambda p=patches: _rho_names(scene, p))
         B = _solve_quick(F, patches)
         chosen = _refine_candidates(patches, B / math.pi, splits)
@@ -195,7 +202,7 @@ def _settings(scene: Scene, patches, form_factors, solver):
 def iter_radiosity(scene: Scene, size: tuple[int, int] | None = None, patches: int | None = None,
                    form_factors: str | None = None, solver: str | None = None,
                    adaptive: bool = True, resolution: int | None = None,
-                   image_every: float = 0.25) -> Iterator[Progress]:
+                   image_every: float = 0.25, hemicube=None) -> Iterator[Progress]:
     """Radiosity as a progressive job: yields :class:`Progress` after each chunk of work.
 
     With ``adaptive`` the job solves a coarse uniform mesh first (``REFINE_SHARE`` of the
@@ -206,8 +213,11 @@ def iter_radiosity(scene: Scene, size: tuple[int, int] | None = None, patches: i
     holds ``patches``, ``form_factors``, ``solver``, ``stage``, timings and ``history``
     (iteration, residual, unshot, time_s of the current stage's solver), and, at the end,
     ``solution`` (a :class:`RadiositySolution`). Close the generator to cancel.
+    ``hemicube``: the GPU backend, required when the method is "hemicube"
+    (``shadelab.render.hemicube.Hemicube``; see :class:`FormFactors`).
     """
     count, method, solver = _settings(scene, patches, form_factors, solver)
+    check_backend(method, hemicube)
     resolution = resolution or scene.radiosity.hemicube_resolution
     precheck(scene, count, method)
     start = time.perf_counter()
@@ -221,7 +231,8 @@ def iter_radiosity(scene: Scene, size: tuple[int, int] | None = None, patches: i
                      meshing_s=time.perf_counter() - start)
         band = (stage / stages, (stage + 1) / stages)
         B = yield from _solve_stage(scene, mesh, method, solver, resolution, size, image_every,
-                                    stats, band, start, final=stage == stages - 1)
+                                    stats, band, start, final=stage == stages - 1,
+                                    hemicube=hemicube)
         if stage == stages - 1:
             break
         budget = count if stage == stages - 2 else len(mesh) + (count - len(mesh)) // 2
@@ -235,10 +246,10 @@ def iter_radiosity(scene: Scene, size: tuple[int, int] | None = None, patches: i
 
 
 def _solve_stage(scene, mesh, method, solver, resolution, size, image_every, stats, band,
-                 start, final):
+                 start, final, hemicube=None):
     """Form factors and a solve of one mesh, yielding progress; returns the display B."""
     settings = scene.radiosity
-    ff = FormFactors(mesh, method, resolution)
+    ff = FormFactors(mesh, method, resolution, hemicube=hemicube)
     history = new_history()
     stats["history"] = history
     span = band[1] - band[0]
@@ -323,9 +334,11 @@ def _fraction(step: Step, scene: Scene) -> float:
 
 def solve_scene(scene: Scene, patches: int | None = None, form_factors: str | None = None,
                 solver: str | None = None, adaptive: bool = True,
-                resolution: int | None = None) -> RadiositySolution:
-    """Mesh, compute form factors and solve; returns the solution (no images)."""
-    job = iter_radiosity(scene, None, patches, form_factors, solver, adaptive, resolution)
+                resolution: int | None = None, hemicube=None) -> RadiositySolution:
+    """Mesh, compute form factors and solve; returns the solution (no images).
+    ``hemicube``: the GPU backend for hemicube form factors (see :func:`iter_radiosity`)."""
+    job = iter_radiosity(scene, None, patches, form_factors, solver, adaptive, resolution,
+                         hemicube=hemicube)
     *_, last = job
     return last.stats["solution"]
 

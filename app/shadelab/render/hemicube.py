@@ -6,8 +6,8 @@ item buffer (``u4`` texture, ``flat out uint``), on the five faces of a hemicube
 frusta). Each pixel carries a delta form factor; F_ij sums those of the pixels showing j.
 Several patches share one atlas so that one read-back serves a batch.
 
-Imported lazily by :mod:`shadelab.radiosity.formfactors`: the radiosity package itself stays
-GL-free.
+The GL-free form-factor engine gets this class passed in as its backend
+(``FormFactors(..., hemicube=Hemicube)``): the radiosity package itself imports no GL.
 """
 
 from __future__ import annotations
@@ -18,8 +18,8 @@ import numpy as np
 from shadelab.gl.context import headless_context
 from shadelab.gl.programs import load_program
 from shadelab.gl.target import bind_anchor
-from shadelab.radiosity.formfactors import hemicube_delta_factors, receiver_samples
 from shadelab.radiosity.patches import PatchSet
+from shadelab.radiosity.sampling import hemicube_delta_factors, receiver_samples
 
 ATLAS_MAX = 4096  # pixels: the atlas is res*5 wide and res*batch high
 

@@ -14,7 +14,8 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 
-from shadelab.render.renderer import VERTEX_ATTRIBUTES, _padded_format, triangle_soup
+from shadelab.gl.blend import restore_blend, set_blend
+from shadelab.gl.vertex import soup_vertex_array, triangle_soup
 
 
 @dataclass
@@ -66,10 +67,8 @@ def draw_sorted(renderer, scene, gpu_meshes, shading: str, sorted_soup: SortedSo
             name = gpu_meshes[position].mesh.material
             program_name = renderer.use_material(scene, name, shading)
             if program_name not in vaos:
-                program = renderer.programs[program_name]
-                layout = [a if a in program else None for a in VERTEX_ATTRIBUTES]
-                vaos[program_name] = ctx.vertex_array(
-                    program, [(vbo, _padded_format(layout), *[a for a in layout if a])])
+                vaos[program_name] = soup_vertex_array(ctx, renderer.programs[program_name],
+                                                       vbo)
             if before_run is not None:
                 before_run(scene.materials[name])
             vaos[program_name].render(moderngl.TRIANGLES, vertices=3 * count, first=3 * first)
@@ -82,8 +81,6 @@ def draw_sorted(renderer, scene, gpu_meshes, shading: str, sorted_soup: SortedSo
 def draw_painter(renderer, scene, gpu_meshes, shading: str, view) -> None:
     """The whole frame by list priority: no depth test, farthest triangles first
     (transparent materials blended as in :mod:`shadelab.render.transparency`)."""
-    from shadelab.render.transparency import restore_blend, set_blend
-
     ctx = renderer.ctx
     ctx.enable_only(moderngl.NOTHING)
     soup = sort_back_to_front(scene, [g.mesh for g in gpu_meshes])

@@ -1,7 +1,7 @@
 """The GL image of a radiosity solution: per-vertex radiance, Gouraud-interpolated by the
 rasterizer (shaders/radiosity.vert/.frag) into a :class:`RenderTarget`, with the camera
 matrices of the raster renderer (:func:`shadelab.render.renderer.make_view`), so the image aligns
-pixel for pixel with the raster and ray-traced images. Imported lazily (GL).
+pixel for pixel with the raster and ray-traced images.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from shadelab.geometry.mesh import scene_meshes
 from shadelab.gl.context import headless_context
 from shadelab.gl.programs import load_program
 from shadelab.gl.target import RenderTarget
-from shadelab.radiosity.hemicube_gl import rebind
+from shadelab.render.hemicube import rebind
 from shadelab.render.renderer import make_view
 from shadelab.scene.camera import gl_matrix
 from shadelab.scene.model import Scene

@@ -15,7 +15,10 @@ import numpy as np
 from shadelab.geometry.mesh import MeshData, geometry_key, object_mesh, scene_bounds
 from shadelab.gl.programs import load_program, set_uniform, set_uniform_array
 from shadelab.gl.target import RenderTarget
+from shadelab.gl.vertex import soup_vertex_array, triangle_soup
+from shadelab.render.painter import draw_painter
 from shadelab.render.textures import TextureCache, has_surface_detail
+from shadelab.render.transparency import draw_transparent
 from shadelab.scene.camera import far_plane, gl_matrix, projection_matrix, view_matrix
 from shadelab.scene.model import MAX_LIGHTS, Light, Material, Scene
 
@@ -25,10 +28,6 @@ SHADING_PROGRAMS = ("flat", "gouraud", "phong")
 TEXTURED_PROGRAMS = {name: f"{name}_tex" for name in SHADING_PROGRAMS}
 LIGHT_KIND_CODES = {"point": 0, "directional": 1, "spot": 2}
 ATTENUATION_CODES = {"none": 0, "inverse_square": 1, "lecture": 2}
-
-# Interleaved per-corner vertex layout shared by every shading program.
-VERTEX_FORMAT = "3f 3f 3f 3f 2f"
-VERTEX_ATTRIBUTES = ("in_position", "in_normal", "in_face_normal", "in_centroid", "in_uv")
 
 
 @dataclass
@@ -45,17 +44,6 @@ class GpuMesh:
         for vao in self.vaos.values():
             vao.release()
         self.vbo.release()
-
-
-def triangle_soup(mesh: MeshData) -> np.ndarray:
-    """(3F, 14) float32: position, corner normal, face normal, centroid, uv per corner."""
-    tri = mesh.triangles
-    faces = len(mesh.faces)
-    centroid = np.repeat(tri.mean(axis=1)[:, None, :], 3, axis=1)
-    face_n = np.repeat(mesh.face_normals[:, None, :], 3, axis=1)
-    uv = mesh.uvs[mesh.faces]
-    soup = np.concatenate([tri, mesh.corner_normals, face_n, centroid, uv], axis=2)
-    return np.ascontiguousarray(soup.reshape(faces * 3, 14), dtype=np.float32)
 
 
 @dataclass
@@ -136,10 +124,7 @@ class Renderer:
         key = (program_name, self.light_signature)
         vao = gpu.vaos.get(key)
         if vao is None:
-            program = self.programs[program_name]
-            layout = [a if a in program else None for a in VERTEX_ATTRIBUTES]
-            vao = self.ctx.vertex_array(program, [(gpu.vbo, _padded_format(layout),
-                                                   *[a for a in layout if a])])
+            vao = soup_vertex_array(self.ctx, self.programs[program_name], gpu.vbo)
             gpu.vaos[key] = vao
         return vao
 
@@ -222,8 +207,6 @@ class Renderer:
         target.clear(settings.background)
         if painter:
             # --- PASS 2 (list priority): every triangle back to front, no depth test
-            from shadelab.render.painter import draw_painter
-
             for variant in self.variants(shading):
                 self.set_frame_uniforms(variant, scene, view, specular)
                 set_uniform(variant, "u_ambient_on", 1.0)
@@ -249,8 +232,6 @@ class Renderer:
         # --- PASS 4: transparent surfaces back to front, blended by their model
         #     (interpolated or filtered), depth-tested against the opaque ones
         if clear:
-            from shadelab.render.transparency import draw_transparent
-
             for variant in self.variants(shading):
                 self.set_frame_uniforms(variant, scene, view, specular)
                 set_uniform(variant, "u_ambient_on", 1.0)
@@ -345,15 +326,6 @@ def _union_bounds(boxes: list[np.ndarray]) -> np.ndarray | None:
 def is_transparent(material: Material) -> bool:
     """Drawn in the blended pass: the lecture's transmission coefficient kt is above 0."""
     return material.kt > 0.0
-
-
-def _padded_format(layout: list[str | None]) -> str:
-    """Buffer format with unused attributes skipped as padding (``12x`` / ``8x``)."""
-    parts = []
-    for fmt, name in zip(VERTEX_FORMAT.split(), layout, strict=True):
-        count = int(fmt[0])
-        parts.append(fmt if name else f"{count * 4}x")
-    return " ".join(parts)
 
 
 def write_light_uniforms(program: moderngl.Program, lights: list[Light],

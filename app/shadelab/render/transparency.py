@@ -1,5 +1,6 @@
 """Transparent surfaces (kt > 0) drawn after the opaque ones, back to front, blended by the
-lecture's two models, chosen per material (``Material.transparency``):
+lecture's two models, chosen per material (``Material.transparency``; the blend state is
+:mod:`shadelab.gl.blend`):
 
 * interpolated: I = (1 - kt) I1 + kt I2
 * filtered:     I = I1 + kt Ot I2
@@ -17,12 +18,8 @@ from __future__ import annotations
 import moderngl
 import numpy as np
 
+from shadelab.gl.blend import restore_blend, set_blend
 from shadelab.render.painter import draw_sorted, sort_back_to_front
-from shadelab.scene.model import Material
-
-GL_CONSTANT_COLOR = 0x8001
-GL_CONSTANT_ALPHA = 0x8003
-GL_ONE_MINUS_CONSTANT_ALPHA = 0x8004
 
 
 def blend_reference(model: str, kt: float, Ot, I1: np.ndarray, I2: np.ndarray) -> np.ndarray:
@@ -30,32 +27,6 @@ def blend_reference(model: str, kt: float, Ot, I1: np.ndarray, I2: np.ndarray) -
     if model == "filtered":
         return I1 + kt * np.asarray(Ot) * I2
     return (1.0 - kt) * I1 + kt * I2
-
-
-def set_blend(ctx: moderngl.Context, material: Material) -> None:
-    """Blend state for one material: off when opaque, else the material's model."""
-    from OpenGL import GL
-
-    if material.kt <= 0.0:
-        ctx.disable(moderngl.BLEND)
-        return
-    ctx.enable(moderngl.BLEND)
-    _ = ctx.error
-    kt = float(material.kt)
-    if material.transparency == "filtered":  # src * 1 + dst * (kt Ot)
-        GL.glBlendColor(*(kt * c for c in material.Ot), 1.0)
-        GL.glBlendFunc(GL.GL_ONE, GL_CONSTANT_COLOR)
-    else:  # src * (1 - kt) + dst * kt
-        GL.glBlendColor(0.0, 0.0, 0.0, kt)
-        GL.glBlendFunc(GL_ONE_MINUS_CONSTANT_ALPHA, GL_CONSTANT_ALPHA)
-
-
-def restore_blend(ctx: moderngl.Context) -> None:
-    from OpenGL import GL
-
-    _ = ctx.error
-    GL.glBlendColor(0.0, 0.0, 0.0, 0.0)
-    ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
 
 
 def draw_transparent(renderer, scene, gpu_meshes, shading: str, view) -> None:

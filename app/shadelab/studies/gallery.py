@@ -193,5 +193,6 @@ def render_case(case: GalleryCase, size: tuple[int, int]) -> tuple[np.ndarray, f
 
 def _render_radiosity(scene, size: tuple[int, int], adaptive: bool = True) -> np.ndarray:
     from shadelab.radiosity.solution import solve_scene
+    from shadelab.render.hemicube import Hemicube  # the GPU backend of hemicube form factors
 
-    return solve_scene(scene, adaptive=adaptive).image(size)
+    return solve_scene(scene, adaptive=adaptive, hemicube=Hemicube).image(size)

@@ -33,12 +33,13 @@ def solve_timed(scene: Scene, patches: int, method: str, resolution: int, solver
                 repeats: int = 1):
     """(solution, milliseconds: best of ``repeats``) for a uniform-patch solve."""
     from shadelab.radiosity.solution import solve_scene
+    from shadelab.render.hemicube import Hemicube  # the GPU backend of hemicube form factors
 
     best = float("inf")
     for _ in range(repeats):
         start = study_clock()
         solution = solve_scene(scene, patches, method, solver, adaptive=False,
-                               resolution=resolution)
+                               resolution=resolution, hemicube=Hemicube)
         best = min(best, (study_clock() - start) * 1000.0)
     return solution, best
 

@@ -1,0 +1,111 @@
+"""The layering of DESIGN.md §1, read from the source with ``ast``: every ``import`` and
+``from ... import`` anywhere in a module (at the top, inside functions, under ``if``) counts,
+lazy imports included, so a deferred import cannot hide a layer violation or a cycle."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1] / "app"
+PACKAGE = "shadelab"
+PURE = ("scene", "shading", "geometry", "raytrace", "radiosity")
+GL_GUI = ("moderngl", "glfw", "imgui_bundle", "OpenGL")
+UPPER = ("gl", "render", "ui", "studies", "cli")
+
+
+def module_name(path: Path) -> str:
+    parts = list(path.relative_to(ROOT).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts.pop()
+    return ".".join(parts)
+
+
+def modules() -> dict[str, Path]:
+    return {module_name(p): p for p in sorted((ROOT / PACKAGE).rglob("*.py"))}
+
+
+def imported(name: str, path: Path) -> list[tuple[str, list[str], int]]:
+    """(absolute module name, names taken from it, line) of every import in the module,
+    wherever it stands (``import a.b`` gives ("a.b", [], line))."""
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    out = []
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), str(path))):
+        if isinstance(node, ast.Import):
+            out += [(alias.name, [], node.lineno) for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                parts = package.split(".")
+                base = ".".join(parts[:len(parts) - node.level + 1] + ([base] if base else []))
+            out.append((base, [alias.name for alias in node.names], node.lineno))
+    return out
+
+
+def internal_graph() -> dict[str, set[str]]:
+    """shadelab module -> the shadelab modules it imports (submodules resolved to files)."""
+    known = modules()
+    graph: dict[str, set[str]] = {name: set() for name in known}
+    for name, path in known.items():
+        for base, names, _ in imported(name, path):
+            # ``from pkg import mod`` imports the submodule pkg.mod where one exists
+            for target in [base, *(f"{base}.{n}" for n in names)]:
+                if target in known and target != name:
+                    graph[name].add(target)
+    return graph
+
+
+def find_cycle(graph: dict[str, set[str]]) -> list[str] | None:
+    """One import cycle as [a, b, ..., a], or None (iterative depth-first search)."""
+    state: dict[str, int] = {}  # 1 on the stack, 2 done
+    for root in sorted(graph):
+        if state.get(root):
+            continue
+        stack = [(root, iter(sorted(graph[root])))]
+        path = [root]
+        state[root] = 1
+        while stack:
+            node, children = stack[-1]
+            child = next(children, None)
+            if child is None:
+                state[node] = 2
+                stack.pop()
+                path.pop()
+            elif state.get(child) == 1:
+                return path[path.index(child):] + [child]
+            elif not state.get(child):
+                state[child] = 1
+                path.append(child)
+                stack.append((child, iter(sorted(graph[child]))))
+    return None
+
+
+def is_under(name: str, prefix: str) -> bool:
+    return name == prefix or name.startswith(prefix + ".")
+
+
+def test_pure_packages_import_no_gl_gui_or_upper_layer():
+    """scene, shading, geometry, raytrace, radiosity: no GL/GUI library and no gl, render,
+    ui, studies or cli module, not even lazily inside a function."""
+    bad = []
+    for name, path in modules().items():
+        if not any(is_under(name, f"{PACKAGE}.{p}") for p in PURE):
+            continue
+        for target, _, line in imported(name, path):
+            forbidden = [lib for lib in GL_GUI if is_under(target, lib)] + \
+                [up for up in UPPER if is_under(target, f"{PACKAGE}.{up}")]
+            if forbidden:
+                bad.append(f"{path.relative_to(ROOT)}:{line}: imports {target}")
+    assert not bad, "pure layer imports GL/GUI or an upper layer:\n" + "\n".join(sorted(set(bad)))
+
+
+def test_no_import_cycle_among_shadelab_modules():
+    """Module-level and function-level imports together form an acyclic graph."""
+    cycle = find_cycle(internal_graph())
+    assert cycle is None, "import cycle: " + " -> ".join(cycle)
+
+
+def test_cycle_finder_reports_a_cycle():
+    graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}
+    assert find_cycle(graph) == ["a", "b", "c", "a"]
+    assert find_cycle({"a": {"b"}, "b": set()}) is None
