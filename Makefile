@@ -3,7 +3,7 @@ PYTHON ?= python3
 VENV ?= .venv
 PY := $(VENV)/bin/python
 
-.PHONY: run test install bench charts screenshots clean
+.PHONY: run test test-fast install bench charts screenshots clean
 
 $(VENV)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -18,6 +18,9 @@ run: install
 
 test: install
 	$(PY) -m pytest -q -n 2 --dist loadfile
+
+test-fast: install  # no GUI, nothing slow: the inner loop while editing
+	$(PY) -m pytest -q -n 2 --dist loadfile -m "not gui and not slow"
 
 bench: install
 	$(VENV)/bin/shadelab bench --json bench.json

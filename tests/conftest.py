@@ -37,7 +37,21 @@ def gl_ctx():
         pytest.skip(f"no EGL: {exc}")
     _ = ctx.error
     yield ctx
-    assert ctx.error == "GL_NO_ERROR"
+
+
+@pytest.fixture(autouse=True)
+def _gl_errors_checked(request):
+    """Every test that used the GL context leaves it without an error (as moderngl's conftest):
+    an error is read before the test (a fault of whoever left it) and after (this test's)."""
+    if "gl_ctx" not in request.fixturenames:
+        yield
+        return
+    ctx = request.getfixturevalue("gl_ctx")
+    before = ctx.error
+    assert before == "GL_NO_ERROR", f"a GL error was left before this test: {before}"
+    yield
+    after = ctx.error
+    assert after == "GL_NO_ERROR", f"this test left a GL error: {after}"
 
 
 @pytest.fixture

@@ -59,9 +59,12 @@ def test05_measured_tessellation_front(gl_ctx, shading):
     rows = measure_sphere(study_scene(), 0, shading, (48, 48), repeats=1)
     records = [dict(zip(COLUMNS, r, strict=True)) for r in rows]
     points = front_from_rows(records, ("level",), "triangles")
-    for budget in (0.02, 2e-3):
-        if pareto_front(points)[-1].error <= budget:
-            _check_choice(points, budget)
+    front = pareto_front(points)
+    assert len(front) >= 2  # finer levels are measurably better
+    # every error on the measured front is a reachable budget; the choice meets it exactly
+    for point in front:
+        choice = _check_choice(points, point.error)
+        assert choice.point == point
 
 
 @pytest.mark.gl
@@ -83,7 +86,6 @@ def test07_render_error_flag_bad_input(tmp_path, capsys, value):
 
 
 def test08_measured_raytrace_front():
-    pytest.importorskip("shadelab.raytrace.whitted")
     from shadelab.scene.preset import load_preset
     from shadelab.studies.autoquality import front_from_rows
     from shadelab.studies.raytrace_study import COLUMNS, measure
@@ -98,7 +100,6 @@ def test08_measured_raytrace_front():
 
 
 def test09_raytrace_error_flag(tmp_path, capsys):
-    pytest.importorskip("shadelab.raytrace.whitted")
     out = tmp_path / "w.png"
     assert main(["raytrace", "whitted", "-o", str(out), "--size", "24x18",
                  "--error", "0.05"]) == 0
@@ -109,7 +110,6 @@ def test09_raytrace_error_flag(tmp_path, capsys):
 
 
 def test10_radiosity_auto_quality():
-    pytest.importorskip("shadelab.radiosity.solution")
     from shadelab.scene.preset import load_preset
     from shadelab.studies.radiosity_study import auto_radiosity
 

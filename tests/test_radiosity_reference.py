@@ -29,7 +29,8 @@ SIZE = (24, 24)
 
 @pytest.fixture(scope="module")
 def images():
-    pathtrace = pytest.importorskip("shadelab.raytrace.pathtrace")
+    from shadelab.raytrace import pathtrace
+
     scene = load_preset("cornell")
     reference = pathtrace.render_pathtraced(scene, SIZE, 512, seed=0)
     solution, image = radiosity_image(scene, SIZE, 400)

@@ -284,7 +284,6 @@ def test_shadow_acne_appears_with_zero_offset():
 
 
 def test_embree_and_bvh_give_the_same_hits(np_rng):
-    pytest.importorskip("embreex")
     from shadelab.raytrace.accel import BvhAccel, EmbreeAccel
 
     scene = load_preset("cornell-spheres")

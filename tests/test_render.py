@@ -101,22 +101,39 @@ def test_phong_and_blinn_peak_at_same_place_when_light_at_eye(gl_ctx):
 
 
 def test_gouraud_equals_reference_at_vertices_of_big_triangles(gl_ctx):
-    """Gouraud colors at a quad's corners are the reference evaluated at those corners."""
+    """Gouraud: the reference evaluated at a quad's corners, interpolated linearly over each
+    triangle; checked at every pixel centre on the quad, including the four next to a corner."""
     quad = Object(shape="quad", material="m", segments=1,
                   vertices=[[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]])
     m = Material(ka=0.1, kd=0.7, ks=0.0)
     light = Light(position=(1.0, 1.0, 1.0), attenuation="inverse_square", Ip=(2.0, 2.0, 2.0))
-    scene = _single(quad, m, [light], eye=(0.0, 0.0, 2.0))
+    # eye 4 units away with a 40 degree field of view: the quad's corners lie inside the image;
+    # the quad faces the eye, so perspective-correct interpolation is linear in screen space
+    scene = _single(quad, m, [light], eye=(0.0, 0.0, 4.0))
     w = 101
     image = render_image(scene, (w, w), "gouraud")
     origins, dirs = primary_rays(scene.camera, w, w)
     t = -origins[..., 2] / dirs[..., 2]
-    points = origins + t[..., None] * dirs
-    corners = np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0.0]])
-    corner_colors = shade(corners, np.array([0, 0, 1.0]), scene.camera.eye, m, [light], (0, 0, 0))
-    # Bilinear isn't exact on two triangles, but along the shared diagonal it is linear:
-    for k in range(len(corners)):
-        d = np.linalg.norm(points[..., :2] - corners[k, :2], axis=-1)
-        iy, ix = np.unravel_index(np.argmin(d), d.shape)
-        if d[iy, ix] < 0.05:
-            np.testing.assert_allclose(image[iy, ix], corner_colors[k], rtol=0.05)
+    points = (origins + t[..., None] * dirs)[..., :2]
+    mesh = scene_meshes(scene)[0]
+    vertex_colors = shade(mesh.vertices, np.array([0, 0, 1.0]), scene.camera.eye, m, [light],
+                          (0, 0, 0))
+    expected = np.full(image.shape, np.nan)
+    for face in mesh.faces:
+        a, b, c = mesh.vertices[face, :2]
+        basis = np.linalg.inv(np.column_stack([b - a, c - a]))
+        uv = (points - a) @ basis.T
+        bary = np.stack([1 - uv[..., 0] - uv[..., 1], uv[..., 0], uv[..., 1]], axis=-1)
+        inside = np.all(bary > 1e-3, axis=-1)  # off the edges (rasterization ties)
+        expected[inside] = bary[inside] @ vertex_colors[face]
+    covered = ~np.isnan(expected[..., 0])
+    assert covered.sum() > 0.8 * (w * 2 / (2 * 4 * np.tan(np.radians(20)))) ** 2
+    np.testing.assert_allclose(image[covered], expected[covered], rtol=2e-3, atol=1e-5)
+    corners = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1.0]])
+    checked = 0
+    for corner in corners:  # the pixel nearest each corner is on the quad and was compared
+        d = np.linalg.norm(points - corner, axis=-1)
+        d[~covered] = np.inf
+        assert d.min() < 0.08, f"no compared pixel centre near corner {corner}"
+        checked += 1
+    assert checked == 4

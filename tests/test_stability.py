@@ -6,8 +6,6 @@ triangles). Renderers that are not built yet are skipped.
 
 from __future__ import annotations
 
-import importlib.util
-
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -145,13 +143,6 @@ def test04_raster_is_finite_and_non_negative(gl_ctx, material, light_list, Ia, s
 
 # ---------------------------------------------------------------- ray tracer, radiosity
 
-def _has(module: str) -> bool:
-    try:
-        return importlib.util.find_spec(module) is not None
-    except ModuleNotFoundError:
-        return False
-
-
 @st.composite
 def trace_materials(draw) -> Material:
     """Local coefficients plus mirror, glass and emission (what the CPU tracers read)."""
@@ -170,7 +161,6 @@ def _trace_scene(ball: Material, floor: Material, light_list: list[Light]) -> Sc
     return scene
 
 
-@pytest.mark.skipif(not _has("shadelab.raytrace.whitted"), reason="ray tracer not built yet")
 @settings(max_examples=15, deadline=None)
 @given(ball=trace_materials(), floor=trace_materials(),
        light_list=st.lists(lights(), min_size=1, max_size=2),
@@ -183,7 +173,6 @@ def test05_raytracer_is_finite_and_non_negative(ball, floor, light_list, depth, 
     _assert_clean(np.asarray(image, dtype=np.float64), "raytrace")
 
 
-@pytest.mark.skipif(not _has("shadelab.raytrace.pathtrace"), reason="path tracer not built yet")
 @settings(max_examples=10, deadline=None)
 @given(ball=trace_materials(), floor=trace_materials(),
        light_list=st.lists(lights(), min_size=1, max_size=2), seed=st.integers(0, 1000))
@@ -216,7 +205,6 @@ def _room(rho: list[float], emitter: int, radiance: float) -> Scene:
     return scene
 
 
-@pytest.mark.skipif(not _has("shadelab.radiosity.solvers"), reason="radiosity not built yet")
 @settings(max_examples=15, deadline=None)
 @given(rho=st.lists(st.floats(0.0, 0.95), min_size=6, max_size=6),
        emitter=st.integers(0, 5), radiance=st.floats(0.01, 100.0),

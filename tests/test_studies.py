@@ -97,8 +97,6 @@ def test07_charts_bad_input(tmp_path, capsys):
 
 @pytest.mark.gl
 def test08_shadow_study_agrees_with_rays_except_zpass_inside(gl_ctx):
-    pytest.importorskip("shadelab.render.shadows")
-    pytest.importorskip("shadelab.raytrace.surface")
     from shadelab.studies.shadow_study import run_shadows
 
     result = run_shadows(quick=True)
@@ -113,7 +111,6 @@ def test08_shadow_study_agrees_with_rays_except_zpass_inside(gl_ctx):
 
 
 def test09_raytrace_study_depth_and_samples_help():
-    pytest.importorskip("shadelab.raytrace.whitted")
     from shadelab.studies.raytrace_study import run_raytrace
 
     result = run_raytrace(quick=True)
@@ -125,7 +122,6 @@ def test09_raytrace_study_depth_and_samples_help():
 
 @pytest.mark.gl
 def test10_radiosity_study(gl_ctx):
-    pytest.importorskip("shadelab.radiosity.solution")
     from shadelab.studies.radiosity_study import run_radiosity
 
     result = run_radiosity(quick=True)
