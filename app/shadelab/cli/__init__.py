@@ -37,7 +37,7 @@ class _Parser(argparse.ArgumentParser):
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="shadelab",
                      description="ShadeLab: an interactive lab for illumination and shading. "
-                                 "Run 'shadelab [PRESET]' to open the viewer (default: cornell).")
+                                 "Run 'shadelab [PRESET]' to open the viewer (default: lecture).")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     for name in COMMAND_MODULES:
         importlib.import_module(name).add_parser(sub)

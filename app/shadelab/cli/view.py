@@ -7,17 +7,17 @@ import os
 
 from shadelab.errors import ShadeLabError
 
-DEFAULT_PRESET = "cornell"
+DEFAULT_PRESET = "lecture"
 NO_DISPLAY = ("no display (DISPLAY and WAYLAND_DISPLAY are unset): use 'shadelab render PRESET "
               "-o OUT.png' for images without a window, or install Xvfb and run "
               "'xvfb-run -a shadelab'")
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("view", help="open the interactive viewer (default preset: cornell)")
+    p = sub.add_parser("view", help="open the interactive viewer (default preset: lecture)")
     p.add_argument("preset", nargs="?", metavar="PRESET",
                    help="preset name from presets/ or a path (default: the last session, or "
-                        "cornell)")
+                        "lecture)")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="override a preset value, e.g. materials.white.kd=0.5")
     p.add_argument("--fresh", action="store_true", help="ignore the autosaved session")

@@ -21,6 +21,7 @@ from imgui_bundle import hello_imgui, imgui, immapp
 from shadelab.geometry.mesh import geometry_key, scene_meshes
 from shadelab.scene.model import Camera
 from shadelab.ui import overlays, panels
+from shadelab.ui.frame import guarded
 from shadelab.ui.offline import draw_offline_panel
 from shadelab.ui.probe import probe
 from shadelab.ui.state import (
@@ -32,7 +33,8 @@ from shadelab.ui.state import (
 )
 from shadelab.ui.studies_panel import draw_gallery_panel, draw_studies_panel
 
-ORBIT_SPEED = 0.008        # radians per pixel dragged
+ORBIT_SPEED = 0.008        # radians per pixel dragged, when no window height is given
+ORBIT_HALF_TURN = math.pi  # a drag across the viewport's height turns this much
 ZOOM_STEP = 0.9            # eye-target distance factor per wheel notch
 CLICK_SLOP = 3.0           # pixels a click may move and still probe
 PRESENTER_SCALE = 1.8      # font scale of presenter mode
@@ -62,8 +64,10 @@ class ViewerOptions:
 # ---------------------------------------------------------------- camera moves
 
 
-def orbit(camera: Camera, dx: float, dy: float) -> None:
-    """Turn the eye around the target: dx about the up axis, dy over the top."""
+def orbit(camera: Camera, dx: float, dy: float, height: int = 0) -> None:
+    """Turn the eye around the target: dx about the up axis, dy over the top. With the
+    viewport's ``height``, a drag across it turns ORBIT_HALF_TURN (180 degrees)."""
+    speed = ORBIT_HALF_TURN / height if height > 0 else ORBIT_SPEED
     eye, target = np.asarray(camera.eye, float), np.asarray(camera.target, float)
     up = np.asarray(camera.up, float) / np.linalg.norm(camera.up)
     offset = eye - target
@@ -74,8 +78,8 @@ def orbit(camera: Camera, dx: float, dy: float) -> None:
     forward = np.cross(right, up)
     elevation = math.asin(max(-1.0, min(1.0, float(np.dot(d, up)))))
     azimuth = math.atan2(float(np.dot(d, right)), float(np.dot(d, forward)))
-    azimuth -= dx * ORBIT_SPEED
-    elevation = max(-1.5, min(1.5, elevation + dy * ORBIT_SPEED))
+    azimuth -= dx * speed
+    elevation = max(-1.5, min(1.5, elevation + dy * speed))
     new_d = (math.cos(elevation) * (math.cos(azimuth) * forward + math.sin(azimuth) * right)
              + math.sin(elevation) * up)
     camera.eye = tuple(float(c) for c in target + radius * new_d)
@@ -294,7 +298,7 @@ class Viewer:
             self.drag += abs(dx) + abs(dy)
             if self.drag > CLICK_SLOP and (dx or dy):
                 if imgui.is_mouse_down(imgui.MouseButton_.left):
-                    orbit(camera, dx, dy)
+                    orbit(camera, dx, dy, size[1])
                 else:
                     pan(camera, dx, dy, size[1])
                 state.mark_edited()
@@ -480,7 +484,7 @@ class Viewer:
         camera = state.scene.camera
         if imgui.is_item_active() and (io.mouse_delta.x or io.mouse_delta.y):
             if imgui.is_mouse_down(imgui.MouseButton_.left):
-                orbit(camera, io.mouse_delta.x, io.mouse_delta.y)
+                orbit(camera, io.mouse_delta.x, io.mouse_delta.y, size[1])
             else:
                 pan(camera, io.mouse_delta.x, io.mouse_delta.y, pane_height)
             state.mark_edited()
@@ -505,10 +509,16 @@ class Viewer:
 
     # ------------------------------------------------------------ per frame
     def panel(self, draw: Callable[[AppState], bool]) -> Callable[[], None]:
+        where = draw.__name__.removeprefix("draw_").removesuffix("_panel").strip("_") + " panel"
+
         def gui() -> None:
-            if draw(self.state):
+            if guarded(lambda: draw(self.state), where, self.report_error):
                 self.state.mark_edited()
         return gui
+
+    def report_error(self, message: str) -> None:
+        """An error a frame raised: shown on the status line and in the viewport."""
+        self.state.error = message
 
     def end_frame(self) -> None:
         """Shortcuts, undo snapshots, autosave, title, scripted exit."""
@@ -648,7 +658,8 @@ def _docking(viewer: Viewer) -> hello_imgui.DockingParams:
         window("Lights", "LeftSpace", p(panels.draw_lights_panel)),
         window("Materials", "LeftSpace", p(panels.draw_materials_panel)),
         window("Objects", "LeftSpace", p(panels.draw_objects_panel)),
-        window("Viewport", "MainDockSpace", viewer.draw_viewport_window),
+        window("Viewport", "MainDockSpace",
+               lambda: guarded(viewer.draw_viewport_window, "viewport", viewer.report_error)),
         window("Equation & probe", "RightSpace", p(panels.draw_equation_panel)),
         window("Studies", "RightSpace", p(draw_studies_panel)),
         window("Failure gallery", "RightSpace", p(draw_gallery_panel)),
@@ -717,7 +728,7 @@ def runner_params(viewer: Viewer) -> hello_imgui.RunnerParams:
     params.callbacks.post_init = viewer.post_init
     params.callbacks.before_exit = viewer.before_exit
     params.callbacks.post_new_frame = lambda: None
-    params.callbacks.show_gui = viewer.end_frame
+    params.callbacks.show_gui = lambda: guarded(viewer.end_frame, "frame", viewer.report_error)
     return params
 
 

@@ -16,9 +16,13 @@ from shadelab.scene.model import (
     SHADING_MODES,
     SPECULAR_MODELS,
     Light,
+    Material,
+    Object,
+    RenderSettings,
 )
 from shadelab.scene.preset import list_presets
 from shadelab.shading import reference
+from shadelab.ui.ranges import field_slider, intensity_range
 from shadelab.ui.state import COMPARE_LABELS, AppState
 
 ERROR_COLOR = imgui.ImVec4(1.0, 0.35, 0.3, 1.0)
@@ -53,8 +57,7 @@ def _intensity_color(label: str, value) -> tuple[bool, tuple[float, float, float
     imgui.push_id(label)
     changed_c, color = _color(f"{label} color", tuple(color))
     changed_s, scale = imgui.slider_float(f"{label} intensity", scale, 0.0,
-                                          max(1e6, scale * 10), "%.4g",
-                                          imgui.SliderFlags_.logarithmic)
+                                          intensity_range(scale), "%.4g")
     imgui.pop_id()
     if changed_c or changed_s:
         return True, tuple(float(c) * scale for c in color)
@@ -143,7 +146,7 @@ def draw_render_panel(state: AppState) -> bool:
         imgui.same_line()
         if imgui.radio_button(SPECULAR_LABELS[model], scene.render.specular == model):
             scene.render.specular, edited = model, True
-    edited |= _edit_fields(scene.render, [("exposure", _slider, 0.01, 100.0, True)])
+    edited |= _edit_fields(scene.render, [("exposure", field_slider(RenderSettings))])
     edited |= _edit_fields(scene, [("Ia", _intensity_color)])
     _, state.show_wireframe = imgui.checkbox("Wireframe (W)", state.show_wireframe)
     imgui.same_line()
@@ -169,13 +172,11 @@ def _light_rows(light: Light, span: float) -> list[tuple]:
         rows.append(("direction", _vec3, 0.01))
     rows.append(("Ip", _intensity_color))
     if light.kind == "spot":
-        rows += [("cone_angle", _slider, 0.0, 90.0), ("spot_exponent", _slider, 0.0, 200.0, True)]
+        rows += [("cone_angle", field_slider(Light)), ("spot_exponent", field_slider(Light))]
     if light.kind != "directional":
         rows.append(("attenuation", _combo, ATTENUATION_MODES))
         if light.attenuation == "lecture":
-            rows += [("c1", _slider, 0.0, 10.0, True, "%.4g"),
-                     ("c2", _slider, 0.0, 1.0, True, "%.4g"),
-                     ("c3", _slider, 0.0, 0.1, True, "%.3g")]
+            rows += [(c, field_slider(Light)) for c in ("c1", "c2", "c3")]
     return rows
 
 
@@ -253,10 +254,10 @@ def _new_light(state: AppState) -> Light:
 # ---------------------------------------------------------------- materials and objects
 
 
-MATERIAL_ROWS = [("ka", _slider, 0.0, 1.0), ("kd", _slider, 0.0, 1.0), ("ks", _slider, 0.0, 1.0),
-                 ("n", _slider, 0.0, 1000.0, True, "%.1f"), ("Od", _color), ("Os", _color)]
-MATERIAL_MORE_ROWS = [("kt", _slider, 0.0, 1.0), ("Ot", _color), ("kr", _slider, -1.0, 1.0),
-                      ("ior", _slider, 1.0, 3.0), ("emission", _intensity_color)]
+_M = field_slider(Material)  # ranges from the model's field table (shadelab.ui.ranges)
+MATERIAL_ROWS = [("ka", _M), ("kd", _M), ("ks", _M), ("n", _M), ("Od", _color), ("Os", _color)]
+MATERIAL_MORE_ROWS = [("kt", _M), ("Ot", _color), ("kr", _M), ("ior", _M),
+                      ("emission", _intensity_color)]
 
 
 def draw_materials_panel(state: AppState) -> bool:
@@ -284,7 +285,7 @@ def draw_objects_panel(state: AppState) -> bool:
             rows: list[tuple] = [("material", _combo, materials),
                                  ("normals", _combo, NORMALS_MODES)]
             if obj.normals == "crease":
-                rows.append(("crease_angle", _slider, 0.0, 180.0))
+                rows.append(("crease_angle", field_slider(Object)))
             edited |= _edit_fields(obj, rows)
             if obj.shape in TESSELLATION_FIELDS:
                 field, lo, hi = TESSELLATION_FIELDS[obj.shape]
