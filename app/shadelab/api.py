@@ -1,0 +1,452 @@
+"""The Python API: presets, renders, the probe and the viewer from a script or a notebook.
+
+Everything here is re-exported from :mod:`shadelab` (``shadelab.render(...)``) and imported
+only on first use, so ``import shadelab`` stays cheap and GL-free. Bad input raises
+:class:`~shadelab.errors.ShadeLabError` with the same one-line message the CLI prints.
+
+Examples
+--------
+>>> import shadelab
+>>> scene = shadelab.load_preset("cornell", overrides={"materials.white.kd": 0.8})
+>>> scene.materials["red"].kd = 0.5          # validated as the TOML is
+>>> image = shadelab.render(scene, size=(256, 256), shading="gouraud")
+>>> image.array.shape, image.array.dtype
+((256, 256, 3), dtype('float32'))
+>>> image.save("cornell.png")                # sRGB PNG; ".npy" keeps linear float32
+"""
+
+from __future__ import annotations
+
+import copy
+import io
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from shadelab.errors import ShadeLabError
+from shadelab.scene.model import SHADING_MODES, SPECULAR_MODELS, Scene
+
+__all__ = ["PIPELINES", "Image", "ShadeLabError", "load_preset", "save_preset", "list_presets",
+           "render", "probe", "show"]
+
+#: What :func:`render` can run; ``raster`` is the z-buffered GL renderer (flat, Gouraud or
+#: Phong shading), ``painter`` the same with list-priority visibility.
+PIPELINES = ("raster", "painter", "raytrace", "pathtrace", "radiosity")
+
+#: The image size each pipeline uses when none is given, as the CLI's defaults.
+DEFAULT_SIZES = {"raster": (800, 600), "painter": (800, 600), "raytrace": (512, 512),
+                 "pathtrace": (256, 256), "radiosity": (512, 512)}
+
+
+# ---------------------------------------------------------------- images
+
+
+class Image:
+    """A rendered image: linear radiance with its display exposure.
+
+    Parameters
+    ----------
+    array : array_like, shape (H, W, 3)
+        Linear RGB radiance (row 0 at the top); stored as C-contiguous float32.
+    exposure : float, optional
+        Scale applied before sRGB encoding for display and PNG output (the scene's
+        ``render.exposure``); ``array`` itself is never scaled.
+    info : dict, optional
+        What made the image (pipeline, shading, size, the renderer's statistics).
+
+    Attributes
+    ----------
+    array : numpy.ndarray, shape (H, W, 3), float32
+        Linear radiance, as ``--npy`` writes it.
+    """
+
+    def __init__(self, array: Any, exposure: float = 1.0, info: dict | None = None):
+        a = np.ascontiguousarray(array, dtype=np.float32)
+        if a.ndim != 3 or a.shape[2] != 3:
+            raise ShadeLabError(f"image: expected an (H, W, 3) array, got shape {a.shape}")
+        self.array = a
+        self.exposure = float(exposure)
+        self.info = dict(info or {})
+
+    @property
+    def shape(self) -> tuple[int, int, int]:
+        """(H, W, 3)."""
+        return self.array.shape
+
+    @property
+    def size(self) -> tuple[int, int]:
+        """(width, height) in pixels, as ``--size`` reads."""
+        return self.array.shape[1], self.array.shape[0]
+
+    def __array__(self, dtype=None, copy=None):
+        return self.array if dtype is None else self.array.astype(dtype)
+
+    def to_srgb8(self) -> np.ndarray:
+        """sRGB-encoded (H, W, 3) uint8 after ``exposure``, as the PNG holds it."""
+        from shadelab.shading.conventions import to_srgb8
+
+        return to_srgb8(self.array, self.exposure)
+
+    def save(self, path: str | Path) -> Path:
+        """Write ``.png`` (sRGB 8-bit) or ``.npy`` (float32 linear radiance).
+
+        Returns
+        -------
+        pathlib.Path
+            The file written.
+        """
+        from shadelab.imageio import check_writable, write_npy, write_png
+
+        path = Path(path)
+        suffix = path.suffix.lower()
+        if suffix not in (".png", ".npy"):
+            raise ShadeLabError(f"save '{path}': expected a .png or .npy file name")
+        check_writable(str(path), "save")
+        if suffix == ".npy":
+            write_npy(str(path), self.array)
+        else:
+            write_png(str(path), self.array, self.exposure)
+        return path
+
+    def _repr_png_(self) -> bytes:
+        """Jupyter's inline display: the sRGB PNG bytes."""
+        from PIL import Image as PILImage
+
+        buffer = io.BytesIO()
+        PILImage.fromarray(self.to_srgb8()).save(buffer, format="PNG")
+        return buffer.getvalue()
+
+    def __repr__(self) -> str:
+        w, h = self.size
+        what = ", ".join(f"{k}={self.info[k]}" for k in ("pipeline", "shading") if k in self.info)
+        return f"<shadelab.Image {w}x{h}{', ' + what if what else ''}>"
+
+
+# ---------------------------------------------------------------- presets
+
+
+def list_presets() -> list[str]:
+    """Names of the presets shipped with ShadeLab, sorted."""
+    from shadelab.scene.preset import list_presets as names
+
+    return names()
+
+
+def _override_items(overrides: Mapping[str, Any] | Sequence[str] | None) -> list[str]:
+    """``{"a.b": 1}`` or ``["a.b=1"]`` -> ``--set`` items (TOML literals for dict values)."""
+    if overrides is None:
+        return []
+    if isinstance(overrides, str):
+        return [overrides]
+    if isinstance(overrides, Mapping):
+        import tomli_w
+
+        items = []
+        for key, value in overrides.items():
+            if hasattr(value, "tolist"):  # numpy scalars and arrays
+                value = value.tolist()
+            if isinstance(value, tuple):
+                value = list(value)
+            try:
+                literal = tomli_w.dumps({"v": value}).split("=", 1)[1].strip()
+            except TypeError:
+                raise ShadeLabError(f"overrides '{key}': cannot use a {type(value).__name__} "
+                                    "(expected a number, bool, string or list)") from None
+            items.append(f"{key}={literal}")
+        return items
+    return [str(item) for item in overrides]
+
+
+def load_preset(name_or_path: str | Path,
+                overrides: Mapping[str, Any] | Sequence[str] | None = None) -> Scene:
+    """Load a preset, apply overrides and validate it.
+
+    Parameters
+    ----------
+    name_or_path : str or pathlib.Path
+        A preset name (``shadelab.list_presets()``) or a path to a TOML file.
+    overrides : dict or list of str, optional
+        Dotted keys as ``--set`` takes them: ``{"materials.white.kd": 0.5, "lights.0.Ip":
+        (2, 2, 2)}`` or ``["materials.white.kd=0.5"]``. Validated exactly as ``--set`` is.
+
+    Returns
+    -------
+    Scene
+        Mutable plain data. Assigning a field validates it against the preset schema
+        (``scene.materials["white"].kd = 1.5`` raises ``ShadeLabError``).
+    """
+    from shadelab.scene.preset import load_preset as load
+
+    return load(str(name_or_path), _override_items(overrides))
+
+
+def save_preset(scene: Scene, path: str | Path) -> None:
+    """Write ``scene`` as a TOML preset (round-trips exactly through :func:`load_preset`)."""
+    from shadelab.scene.preset import save_preset as save
+
+    save(scene, path)
+
+
+def _scene(scene: Scene | str | Path) -> Scene:
+    if isinstance(scene, Scene):
+        return scene
+    if isinstance(scene, (str, Path)):
+        return load_preset(scene)
+    raise ShadeLabError(f"expected a Scene or a preset name, got {type(scene).__name__}")
+
+
+def _size(size: Any, pipeline: str) -> tuple[int, int]:
+    from shadelab.imageio import parse_size
+
+    if size is None:
+        return DEFAULT_SIZES[pipeline]
+    if isinstance(size, str):
+        return parse_size(size)
+    if isinstance(size, (int, np.integer)) and not isinstance(size, bool):
+        return parse_size(str(int(size)))
+    try:
+        w, h = (int(v) for v in size)
+    except (TypeError, ValueError):
+        raise ShadeLabError(f"size {size!r}: expected (width, height), N or 'WxH'") from None
+    return parse_size(f"{w}x{h}")
+
+
+# ---------------------------------------------------------------- rendering
+
+
+def render(scene: Scene | str, size: Any = None, shading: str | None = None,
+           pipeline: str = "raster", *, specular: str | None = None, depth: int | None = None,
+           spp: int | None = None, seed: int = 0, fresnel: bool | None = None,
+           patches: int | None = None, form_factors: str | None = None,
+           solver: str | None = None, backend: str = "auto", workers: int = 1,
+           progress: bool = False) -> Image:
+    """Render a scene headless with any of ShadeLab's pipelines.
+
+    Parameters
+    ----------
+    scene : Scene or str
+        A scene (from :func:`load_preset`) or a preset name. It is not modified.
+    size : (int, int) or int or str, optional
+        (width, height) in pixels, ``N`` for a square or ``"WxH"``; each side in [1, 16384].
+        Default: the CLI's size for the pipeline (800x600 raster, 512x512 ray tracing and
+        radiosity, 256x256 path tracing).
+    shading : {"flat", "gouraud", "phong"}, optional
+        Raster and painter pipelines only; default the scene's ``render.shading``.
+    pipeline : {"raster", "painter", "raytrace", "pathtrace", "radiosity"}
+        ``raster``: GL z-buffer (``shadelab render``); ``painter``: list priority
+        (``--visibility painter``); ``raytrace``: Whitted (``shadelab raytrace``);
+        ``pathtrace``: Monte Carlo reference (``shadelab pathtrace``); ``radiosity``: solved
+        patches shown Gouraud-shaded (``shadelab radiosity``).
+    specular : {"phong", "blinn"}, optional
+        Raster pipelines: (R.V)^n or (N.H)^n; default the scene's ``render.specular``.
+    depth, spp, fresnel : optional
+        Ray tracing: recursion depth, samples per pixel (path tracing default 64), Fresnel.
+    seed : int
+        Path tracing random seed.
+    patches, form_factors, solver : optional
+        Radiosity: target patch count, ``hemicube`` or ``raycast``, the solver.
+    backend : {"auto", "embree", "bvh"}
+        Ray casting backend of the CPU tracers.
+    workers : int
+        Processes tracing tiles in parallel (CPU tracers).
+    progress : bool
+        Show a tqdm bar for the offline pipelines.
+
+    Returns
+    -------
+    Image
+        ``.array`` is float32 linear radiance, shape (H, W, 3), row 0 at the top, aligned
+        pixel for pixel across pipelines; ``.info`` holds the pipeline and its statistics.
+    """
+    scene = _scene(scene)
+    if pipeline not in PIPELINES:
+        raise ShadeLabError(f"pipeline '{pipeline}': expected one of {', '.join(PIPELINES)}")
+    if shading is not None and shading not in SHADING_MODES:
+        raise ShadeLabError(f"shading '{shading}': expected one of {', '.join(SHADING_MODES)}")
+    if shading is not None and pipeline not in ("raster", "painter"):
+        raise ShadeLabError(f"shading '{shading}': applies to the raster and painter "
+                            f"pipelines, not {pipeline}")
+    if specular is not None and specular not in SPECULAR_MODELS:
+        raise ShadeLabError(f"specular '{specular}': expected one of "
+                            f"{', '.join(SPECULAR_MODELS)}")
+    wh = _size(size, pipeline)
+    exposure = scene.render.exposure
+    info: dict[str, Any] = {"pipeline": pipeline, "size": wh}
+    if pipeline in ("raster", "painter"):
+        from shadelab.render.offscreen import render_image
+
+        if pipeline == "painter" and scene.render.visibility != "painter":
+            scene = copy.deepcopy(scene)
+            scene.render.visibility = "painter"
+        info["shading"] = shading or scene.render.shading
+        return Image(render_image(scene, wh, shading, specular), exposure, info)
+    from shadelab.cli.raytrace import _check_counts, _check_scene
+    from shadelab.progress import run_to_end
+
+    label = scene.name or "scene"
+    _check_counts(depth if pipeline == "raytrace" else None, spp, workers)
+    if pipeline == "raytrace":
+        _check_scene(scene, label)
+        if not scene.active_lights():
+            raise ShadeLabError(f"{label}: lights: the ray tracer needs at least one "
+                                "enabled light")
+        from shadelab.raytrace.whitted import iter_raytrace
+
+        last = run_to_end(iter_raytrace(scene, wh, depth, spp, fresnel, backend,
+                                        workers=workers), desc="raytrace", show=progress)
+        info.update(last.stats)
+        return Image(last.image, exposure, info)
+    if pipeline == "pathtrace":
+        _check_scene(scene, label)
+        if not any(np.max(scene.materials[o.material].emission) > 0.0 for o in scene.objects):
+            raise ShadeLabError(f"{label}: materials: the path tracer needs an emitter "
+                                "(a material with emission > 0 on some object)")
+        from shadelab.raytrace.pathtrace import iter_pathtrace
+
+        spp = 64 if spp is None else spp
+        last = run_to_end(iter_pathtrace(scene, wh, spp, seed, backend, workers=workers),
+                          desc="pathtrace", show=progress)
+        info.update(last.stats, spp=spp)
+        return Image(last.image, exposure, info)
+    # radiosity, as shadelab radiosity does it
+    if patches is not None:
+        from shadelab.radiosity.patches import check_count
+
+        check_count(patches)
+    from shadelab.radiosity.solution import iter_radiosity, precheck
+
+    precheck(scene, patches or scene.radiosity.patches,
+             form_factors or scene.radiosity.form_factors)
+    last = run_to_end(iter_radiosity(scene, None, patches, form_factors, solver),
+                      desc="radiosity", show=progress)
+    solution = last.stats["solution"]
+    from shadelab.render.radiosity_image import render_solution
+
+    stats = {k: v for k, v in solution.stats.items() if k != "history"}
+    info.update(stats)
+    return Image(render_solution(solution, wh), exposure, info)
+
+
+# ---------------------------------------------------------------- the probe
+
+
+def _vec(v: Any) -> tuple[float, ...]:
+    return tuple(float(c) for c in np.asarray(v, dtype=np.float64).reshape(-1))
+
+
+def probe(scene: Scene | str, pixel: tuple[int, int], size: Any = (800, 600),
+          shading: str | None = None, specular: str | None = None) -> dict | None:
+    """The lecture's terms at the surface point a pixel shows (the viewer's probe, as data).
+
+    Parameters
+    ----------
+    scene : Scene or str
+        A scene or a preset name.
+    pixel : (int, int)
+        (x, y) of a ``size`` image, row 0 at the top (as :func:`render` lays it out).
+    size : (int, int) or int or str
+        The image the pixel belongs to; default 800x600 (the raster default).
+    shading, specular : str, optional
+        As :func:`render`; default the scene's.
+
+    Returns
+    -------
+    dict or None
+        None when the pixel shows the background. Otherwise plain Python data (JSON-ready):
+        ``pixel``, ``shading``, ``specular``, ``object`` (index into ``scene.objects``),
+        ``material`` (name), ``face``, ``t`` (ray distance, world units), ``point`` (3,),
+        ``normal`` (3,) unit N facing the viewer, ``to_eye`` (3,) unit V, ``emission`` (3,),
+        ``ambient`` (3,) Ia ka Od, ``lights``: one dict per enabled light with ``to_light``
+        (3,) unit L, ``reflected`` (3,) R (or H for Blinn), ``distance``, ``f_att``,
+        ``clamped`` (the lecture's min(., 1) active), ``spot``, ``shadow`` S,
+        ``diffuse`` (3,) and ``specular`` (3,) radiance; ``total`` (3,) the equation at the
+        point and ``reference`` (3,) what the shading mode computes at this pixel (linear
+        RGB, before exposure).
+    """
+    scene = _scene(scene)
+    wh = _size(size, "raster")
+    try:
+        x, y = (int(v) for v in pixel)
+    except (TypeError, ValueError):
+        raise ShadeLabError(f"pixel {pixel!r}: expected (x, y)") from None
+    if not (0 <= x < wh[0] and 0 <= y < wh[1]):
+        raise ShadeLabError(f"pixel ({x}, {y}): outside the {wh[0]}x{wh[1]} image")
+    if shading is not None and shading not in SHADING_MODES:
+        raise ShadeLabError(f"shading '{shading}': expected one of {', '.join(SHADING_MODES)}")
+    if specular is not None and specular not in SPECULAR_MODELS:
+        raise ShadeLabError(f"specular '{specular}': expected one of "
+                            f"{', '.join(SPECULAR_MODELS)}")
+    from shadelab.ui.probe import probe as run_probe  # pure numpy, no GL
+
+    result = run_probe(scene, wh, (x, y), shading, specular)
+    if result is None:
+        return None
+    terms = result.terms
+    lights = []
+    for i, term in enumerate(terms.lights):
+        lights.append({"to_light": _vec(term.to_light), "reflected": _vec(result.reflected(i)),
+                       "distance": float(term.distance), "f_att": float(term.f_att),
+                       "clamped": bool(term.clamp_active), "spot": float(term.spot),
+                       "shadow": float(term.shadow), "diffuse": _vec(term.diffuse),
+                       "specular": _vec(term.specular)})
+    return {"pixel": (x, y), "shading": result.shading, "specular": result.specular,
+            "object": int(result.hit.mesh.index), "material": result.hit.mesh.material,
+            "face": int(result.hit.face), "t": float(result.hit.t),
+            "point": _vec(result.point), "normal": _vec(result.normal),
+            "to_eye": _vec(result.to_eye), "emission": _vec(terms.emission),
+            "ambient": _vec(terms.ambient), "lights": lights, "total": _vec(terms.total),
+            "reference": _vec(result.reference)}
+
+
+# ---------------------------------------------------------------- the viewer
+
+
+def show(scene: Scene | str, window: Any = (1600, 900), frames: int = 0,
+         screenshot: str | Path | None = None, autosave: bool = False) -> int:
+    """Open the interactive viewer on ``scene`` (blocks until the window is closed).
+
+    Parameters
+    ----------
+    scene : Scene or str
+        The scene to view; the viewer edits a copy, ``scene`` itself is left as it is.
+    window : (int, int) or str
+        Window size in pixels.
+    frames : int
+        Quit after this many frames (0: run until closed).
+    screenshot : str or pathlib.Path, optional
+        Write a PNG of the window at exit.
+    autosave : bool
+        Save the session like ``shadelab view`` does (off: a script's scene does not replace
+        the user's autosaved session).
+
+    Returns
+    -------
+    int
+        The viewer's exit code (0).
+    """
+    import os
+
+    from shadelab.cli.view import NO_DISPLAY
+
+    scene = _scene(scene)
+    if not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
+        raise ShadeLabError(NO_DISPLAY)
+    if frames < 0:
+        raise ShadeLabError(f"frames {frames}: expected a count >= 0")
+    from shadelab.imageio import check_writable
+
+    shot = str(screenshot) if screenshot else ""
+    check_writable(shot or None, "screenshot")
+    wh = _size(window, "raster")
+    from shadelab.geometry.mesh import scene_meshes
+
+    scene = copy.deepcopy(scene)
+    scene_meshes(scene)  # a broken mesh file fails here, with its one-line reason
+    from shadelab.ui.app import ViewerOptions, run_viewer
+    from shadelab.ui.state import AppState
+
+    state = AppState.from_scene(scene, scene.name or "script")
+    options = ViewerOptions(frames=frames, screenshot=shot, window_size=wh, autosave=autosave)
+    return int(run_viewer(state, options) or 0)
