@@ -9,7 +9,7 @@ Names follow the lecture (``Ia``, ``ka``, ``kd``, ``ks``, ``n``, ``Od``, ``Os``,
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 Rgb = tuple[float, float, float]
@@ -54,8 +54,36 @@ COEFF_MAX = 1e12  # attenuation coefficients c1, c2, c3
 COORD = (-LENGTH_MAX, LENGTH_MAX)
 
 
+class Checked:
+    """Assignments to a spec'd field after construction are validated as a preset value is.
+
+    ``scene.materials["white"].kd = 1.5`` raises :class:`~shadelab.errors.ShadeLabError`
+    (``Material: key 'kd': expected a number in [0, 1], got 1.5``) and the value stays as it
+    was; a valid value is stored in canonical form (a list of three numbers becomes a tuple).
+    Construction itself is not checked (the preset loader checks every key it sets).
+    """
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if self.__dict__.get("_checked"):
+            specs = _SPECCED.get(type(self))
+            if specs is None:
+                specs = _SPECCED[type(self)] = {f.name for f in fields(self)
+                                               if "spec" in f.metadata}
+            if name in specs:
+                from shadelab.scene.preset import _check  # preset imports this module
+
+                value = _check(type(self), name, value, type(self).__name__, name)
+        object.__setattr__(self, name, value)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "_checked", True)
+
+
+_SPECCED: dict[type, set[str]] = {}
+
+
 @dataclass
-class Camera:
+class Camera(Checked):
     """A pinhole camera; ``fov_y`` is the full vertical field of view in degrees."""
 
     eye: Point3 = spec((0.0, 1.0, 5.0), "vec3", *COORD, doc="camera position, world units")
@@ -66,7 +94,7 @@ class Camera:
 
 
 @dataclass
-class Light:
+class Light(Checked):
     """A point, directional or spot light of RGB intensity ``Ip``.
 
     ``direction`` is the way the light travels (a directional light's rays; a spot's axis);
@@ -88,7 +116,7 @@ class Light:
 
 
 @dataclass
-class Material:
+class Material(Checked):
     """The lecture's coefficients: ``kd`` scales the diffuse color ``Od``, ``ks`` the specular
     color ``Os``."""
 
@@ -118,7 +146,7 @@ class Material:
 
 
 @dataclass
-class Object:
+class Object(Checked):
     """A trimesh primitive or a mesh file, placed by scale, then rotate (XYZ, degrees), then
     translate."""
 
@@ -147,7 +175,7 @@ class Object:
 
 
 @dataclass
-class RenderSettings:
+class RenderSettings(Checked):
     """How the raster viewer draws the scene."""
 
     shading: str = spec("phong", "str", SHADING_MODES, doc="flat | gouraud | phong")
@@ -164,7 +192,7 @@ class RenderSettings:
 
 
 @dataclass
-class RaytraceSettings:
+class RaytraceSettings(Checked):
     """Whitted ray tracer and path tracer settings."""
 
     depth: int = spec(5, "int", 0, 64, doc="maximum recursion depth")
@@ -175,7 +203,7 @@ class RaytraceSettings:
 
 
 @dataclass
-class RadiositySettings:
+class RadiositySettings(Checked):
     """Radiosity meshing and solver settings."""
 
     patches: int = spec(400, "int", 1, 1000000, doc="target patch count")
@@ -187,7 +215,7 @@ class RadiositySettings:
 
 
 @dataclass
-class Scene:
+class Scene(Checked):
     """Everything a renderer needs; ``base_dir`` resolves relative mesh and texture paths."""
 
     description: str = spec("", "str", None, doc="what this preset teaches")
