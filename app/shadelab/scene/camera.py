@@ -1,7 +1,9 @@
 """Camera math shared by every renderer, so raster, ray-traced and radiosity images align.
 
-Matrices follow pyrr's row-vector convention (``p_clip = p_world @ clip_from_world``);
-:func:`gl_matrix` gives the column-major bytes GLSL expects.
+One matrix convention everywhere (pbrt's): column vectors, ``p_b = b_from_a @ p_a``, and every
+matrix is named ``bFromA`` (``clip_from_world = clip_from_view @ view_from_world``). pyrr builds
+row-vector matrices; they are transposed once here, and :func:`gl_matrix` transposes once more
+at the GL boundary into the column-major bytes GLSL expects.
 """
 
 from __future__ import annotations
@@ -27,25 +29,30 @@ def camera_basis(camera: Camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return forward, right, up
 
 
-def view_matrix(camera: Camera) -> np.ndarray:
-    """``view_from_world`` as a pyrr (row-vector) 4x4 float64 matrix."""
+def view_from_world(camera: Camera) -> np.ndarray:
+    """4x4 float64 ``view_from_world`` (column vectors): the eye at the origin looking down -z."""
     forward, _, up = camera_basis(camera)
     eye = np.asarray(camera.eye, dtype=np.float64)
-    return np.asarray(Matrix44.look_at(eye, eye + forward, up), dtype=np.float64)
+    return np.asarray(Matrix44.look_at(eye, eye + forward, up), dtype=np.float64).T
 
 
-def projection_matrix(camera: Camera, aspect: float, far: float) -> np.ndarray:
-    """``clip_from_view``: a perspective with the camera's vertical fov; ``far`` may be inf."""
+def clip_from_view(camera: Camera, aspect: float, far: float) -> np.ndarray:
+    """4x4 float64 ``clip_from_view`` (column vectors): a perspective with the camera's vertical
+    fov; ``far`` may be inf (the infinite far plane of Everitt & Kilgard 2002)."""
     if math.isinf(far):
         f = 1.0 / math.tan(math.radians(camera.fov_y) / 2.0)
         near = camera.near
-        # Infinite far plane (Everitt & Kilgard 2002), row-vector layout like pyrr's.
         return np.array([[f / aspect, 0, 0, 0],
                          [0, f, 0, 0],
-                         [0, 0, -1.0, -1.0],
-                         [0, 0, -2.0 * near, 0]], dtype=np.float64)
+                         [0, 0, -1.0, -2.0 * near],
+                         [0, 0, -1.0, 0]], dtype=np.float64)
     return np.asarray(Matrix44.perspective_projection(camera.fov_y, aspect, camera.near, far),
-                      dtype=np.float64)
+                      dtype=np.float64).T
+
+
+def clip_from_world(camera: Camera, aspect: float, far: float) -> np.ndarray:
+    """4x4 float64 ``clip_from_world = clip_from_view @ view_from_world`` (column vectors)."""
+    return clip_from_view(camera, aspect, far) @ view_from_world(camera)
 
 
 def far_plane(camera: Camera, bounds: np.ndarray) -> float:
@@ -57,8 +64,9 @@ def far_plane(camera: Camera, bounds: np.ndarray) -> float:
 
 
 def gl_matrix(matrix: np.ndarray) -> bytes:
-    """Bytes of a pyrr matrix as a GLSL ``mat4`` uniform (float32, column-major)."""
-    return np.ascontiguousarray(matrix, dtype=np.float32).tobytes()
+    """Bytes of a column-vector ``bFromA`` matrix as a GLSL ``mat4`` uniform (float32,
+    column-major: the one transpose at the GL boundary)."""
+    return np.ascontiguousarray(np.asarray(matrix).T, dtype=np.float32).tobytes()
 
 
 def primary_rays(camera: Camera, width: int, height: int,
