@@ -27,7 +27,23 @@ def test_preset_loads_and_round_trips(name, tmp_path):
     path = tmp_path / f"{name}.toml"
     save_preset(scene, path)
     again = load_preset(str(path))
-    assert scene_to_dict(again) == scene_to_dict(scene)
+    assert _with_resolved_files(again) == _with_resolved_files(scene)
+
+
+def _with_resolved_files(scene) -> dict:
+    """scene_to_dict with mesh and image paths resolved: a preset saved elsewhere names the
+    same files by other relative paths (save_preset rebases them)."""
+    data = scene_to_dict(scene)
+
+    def full(value: str) -> str:
+        return str((Path(scene.base_dir) / value).resolve()) if value else value
+
+    for obj in data["objects"]:
+        obj["path"] = full(obj["path"])
+    for m in data["materials"].values():
+        m["texture"] = m["texture"] if m["texture"] == "checker" else full(m["texture"])
+        m["bump"] = m["bump"] if m["bump"] == "bumps" else full(m["bump"])
+    return data
 
 
 def test_cornell_matches_published_data():

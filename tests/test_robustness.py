@@ -204,3 +204,182 @@ def test_seed_out_of_range(tmp_path, capsys, seed):
     argv = ["pathtrace", _preset(tmp_path, light), "-o", str(tmp_path / "x.png"),
             "--size", "4x4", "--spp", "1", "--seed", seed]
     assert "expected an integer in [0, 2**63 - 1]" in one_error(capsys, argv)
+
+
+# ---------------------------------------------------------------- 4. meshes and images
+
+
+def _mesh_preset(tmp_path: Path, mesh_text: bytes | None, texture: str = "",
+                 name: str = "m.obj") -> str:
+    if mesh_text is not None:
+        (tmp_path / name).write_bytes(mesh_text)
+    return _preset(tmp_path, f"""schema_version = 1
+[materials.m]
+texture = "{texture}"
+[[lights]]
+position = [0.0, 5.0, 0.0]
+[[objects]]
+shape = "mesh"
+path = "{name}"
+material = "m"
+""")
+
+
+TRI = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\n"
+
+
+@pytest.mark.parametrize("bad, first", [(b"nan 0 0", "vertex 1 = (nan, 0, 0)"),
+                                         (b"0 inf 0", "vertex 1 = (0, inf, 0)"),
+                                         (b"0 0 -1e300", "vertex 1 = (0, 0, -1e+300)")])
+def test_non_finite_mesh_vertices_are_refused_at_load(tmp_path, capsys, bad, first):
+    text = TRI.replace(b"v 1 0 0", b"v " + bad)
+    err = one_error(capsys, ["validate", _mesh_preset(tmp_path, text)])
+    assert "objects.0.path" in err and "m.obj" in err and first in err
+
+
+def test_obj_with_a_latin1_comment_loads(tmp_path, capsys):
+    assert main(["validate", _mesh_preset(tmp_path, b"# mod\xe8le \xa9 2024\n" + TRI)]) == 0
+    assert "2 triangles" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("make, expected", [
+    (lambda p: p.mkdir(), "is a folder"),
+    (lambda p: __import__("os").mkfifo(p), "not a regular file"),
+    (lambda p: (p.symlink_to(p.with_name("loop")), p.with_name("loop").symlink_to(p)),
+     "symlink loop"),
+    (lambda p: None, "not found"),
+])
+def test_texture_or_mesh_path_that_is_no_file(tmp_path, capsys, make, expected):
+    make(tmp_path / "t.png")
+    err = one_error(capsys, ["validate", _mesh_preset(tmp_path, TRI, texture="t.png")])
+    assert "materials.m.texture" in err and expected in err
+    make(tmp_path / "x.obj") if expected != "symlink loop" else None
+    err = one_error(capsys, ["validate", _mesh_preset(tmp_path, None, name="x.obj")])
+    assert "objects.0.path" in err
+
+
+def _png_header(width: int, height: int) -> bytes:
+    """A PNG whose header claims width x height (no pixel data: PIL reads headers lazily)."""
+    import struct
+    import zlib
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(
+            ">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+    ihdr = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)
+    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IEND", b"")
+
+
+def test_decompression_bomb_texture_is_refused_with_the_limit(tmp_path, capsys, monkeypatch):
+    (tmp_path / "big.png").write_bytes(_png_header(20000, 20000))
+    preset = _mesh_preset(tmp_path, TRI, texture="big.png")
+    err = one_error(capsys, ["validate", preset])
+    assert "20000x20000 = 400 Mpixels" in err and "limit of 67 Mpixels" in err
+    assert "SHADELAB_MAX_TEXTURE_PIXELS" in err
+    (tmp_path / "ok.png").write_bytes(_png_header(9000, 9000))
+    preset = _mesh_preset(tmp_path, TRI, texture="ok.png")
+    assert main(["validate", preset]) == 2  # 81 Mpixels: over the default
+    capsys.readouterr()
+    monkeypatch.setenv("SHADELAB_MAX_TEXTURE_PIXELS", str(10**8))
+    assert main(["validate", preset]) == 0  # allowed when asked for
+
+
+# ---------------------------------------------------------------- 3. paths
+
+
+def _rt(tmp_path: Path, *extra: str) -> list[str]:
+    return ["raytrace", _preset(tmp_path, GOOD), "--size", "4x4", *extra]
+
+
+def _listing(folder: Path) -> dict:
+    return {p.name: p.read_bytes() for p in folder.iterdir() if p.is_file()}
+
+
+@pytest.mark.parametrize("make, args, expected", [
+    (lambda d: __import__("os").mkfifo(d / "fifo"), ["-o", "fifo.png", "--npy", "fifo"],
+     "not a regular file"),
+    (lambda d: ((d / "l1.png").symlink_to("l2.png"), (d / "l2.png").symlink_to("l1.png")),
+     ["-o", "l1.png"], "symlink loop"),
+    (lambda d: None, ["-o", "a" * 300 + ".png"], "name too long"),
+    (lambda d: None, ["-o", "x.png", "--npy", "a\nb.npy"], "line break"),
+    (lambda d: None, ["-o", "x.png", "--npy", "/dev/full"], "not a regular file"),
+    (lambda d: ((d / "ro.npy").write_bytes(b"keep"), (d / "ro.npy").chmod(0o444)),
+     ["-o", "x.png", "--npy", "ro.npy"], "read-only"),
+    (lambda d: None, ["-o", "x.png", "--npy", "p.toml"], "is the input preset"),
+    (lambda d: None, ["-o", "x.png", "--npy", "x.png"], "the same file as -o"),
+    (lambda d: None, ["-o", "x.exr"], "expected an image file name ending in .png"),
+    (lambda d: None, ["-o", "noext"], "expected an image file name"),
+    (lambda d: None, ["-o", "missing/x.png"], "does not exist"),
+])
+def test_bad_output_paths_are_refused_before_any_work(tmp_path, capsys, monkeypatch, make,
+                                                      args, expected):
+    monkeypatch.chdir(tmp_path)
+    make(tmp_path)
+    argv = _rt(tmp_path, *args)
+    before = _listing(tmp_path)
+    assert expected in one_error(capsys, argv)
+    assert _listing(tmp_path) == before  # nothing written, nothing changed, no stray file
+
+
+def test_npy_name_is_exactly_the_one_given(tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    assert main(_rt(tmp_path, "-o", str(out / "a.png"), "--npy", str(out / "arr.bin"))) == 0
+    assert sorted(p.name for p in out.iterdir()) == ["a.png", "arr.bin"]
+    import numpy as np
+
+    assert np.load(out / "arr.bin").shape == (4, 4, 3)
+
+
+def test_symlinked_output_is_written_through(tmp_path):
+    target = tmp_path / "shared.png"
+    target.write_bytes(b"old")
+    target.chmod(0o640)
+    link = tmp_path / "link.png"
+    link.symlink_to(target.name)
+    dangling = tmp_path / "dangling.npy"
+    dangling.symlink_to("made.npy")
+    assert main(_rt(tmp_path, "-o", str(link), "--npy", str(dangling))) == 0
+    assert link.is_symlink() and dangling.is_symlink()
+    assert target.read_bytes()[:4] == b"\x89PNG" and (target.stat().st_mode & 0o777) == 0o640
+    assert (tmp_path / "made.npy").is_file()
+
+
+def test_a_failed_write_leaves_no_output_at_all(tmp_path, monkeypatch):
+    """The second output fails (a full disk): the first is not left behind either."""
+    import errno
+
+    import numpy as np
+
+    from shadelab import imageio
+
+    def full_disk(array):
+        def write(handle):
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return write
+
+    monkeypatch.setattr(imageio, "_npy_writer", full_disk)
+    (tmp_path / "a.png").write_bytes(b"previous run")
+    args = type("A", (), {"output": str(tmp_path / "a.png"), "npy": str(tmp_path / "a.npy")})
+    with pytest.raises(ShadeLabError, match="No space left on device"):
+        imageio.save_outputs(args, np.zeros((2, 2, 3), np.float32))
+    assert _listing(tmp_path) == {"a.png": b"previous run"}
+
+
+def test_interrupt_leaves_no_partial_file(tmp_path, monkeypatch, capsys):
+    import numpy as np
+
+    from shadelab import imageio
+
+    def interrupted(array):
+        def write(handle):
+            handle.write(b"partial")
+            raise KeyboardInterrupt
+        return write
+
+    monkeypatch.setattr(imageio, "_npy_writer", interrupted)
+    assert main(_rt(tmp_path, "-o", str(tmp_path / "a.png"), "--npy",
+                    str(tmp_path / "a.npy"))) == 130
+    assert "interrupted" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["p.toml"]
+    del np

@@ -9,6 +9,7 @@ import numpy as np
 from PIL import Image
 
 from shadelab.errors import ShadeLabError
+from shadelab.paths import OutputSet, output_problem, same_file
 from shadelab.shading.conventions import to_srgb8
 
 MAX_SIZE = 16384  # pixels per side
@@ -31,40 +32,48 @@ def parse_size(text: str) -> tuple[int, int]:
     return w, h
 
 
+IMAGE_FORMATS = {".png": "PNG", ".jpg": "JPEG", ".jpeg": "JPEG", ".tif": "TIFF",
+                 ".tiff": "TIFF", ".bmp": "BMP"}
+
+
 def check_writable(path: str | None, flag: str) -> None:
-    """Fail before any work if ``path`` cannot be written (nothing is half-written later)."""
+    """Fail before any work if ``path`` cannot be written; nothing is created or changed."""
     if not path:
         return
-    target = Path(path)
-    folder = target.resolve().parent
-    if not folder.is_dir():
-        raise ShadeLabError(f"{flag} '{path}': folder '{folder}' does not exist")
-    if target.is_dir():
-        raise ShadeLabError(f"{flag} '{path}': is a folder, expected a file name")
-    existed = target.exists()
-    try:  # append mode: an existing file is left as it is
-        with open(target, "ab"):
-            pass
-    except OSError as exc:
-        raise ShadeLabError(f"{flag} '{path}': not writable ({exc.strerror})") from None
-    if not existed:
-        target.unlink(missing_ok=True)
+    problem = output_problem(path)
+    if problem:
+        raise ShadeLabError(f"{flag} '{path}': {problem}")
+
+
+def check_image_name(path: str | None, flag: str) -> None:
+    """An 8-bit image file name: its extension says the format (checked before any work)."""
+    if path and Path(path).suffix.lower() not in IMAGE_FORMATS:
+        raise ShadeLabError(f"{flag} '{path}': expected an image file name ending in "
+                            f"{', '.join(IMAGE_FORMATS)} (--npy writes float data)")
+
+
+def _png_writer(path: str, linear: np.ndarray, exposure: float):
+    image = Image.fromarray(to_srgb8(linear, exposure))
+    fmt = IMAGE_FORMATS.get(Path(path).suffix.lower(), "PNG")
+    return lambda handle: image.save(handle, format=fmt)
+
+
+def _npy_writer(linear: np.ndarray):
+    array = np.ascontiguousarray(linear, dtype=np.float32)
+    return lambda handle: np.save(handle, array)  # a handle: exactly the name given
 
 
 def write_png(path: str, linear: np.ndarray, exposure: float = 1.0) -> None:
-    """Write linear RGB (H, W, 3) as an sRGB PNG."""
-    try:
-        Image.fromarray(to_srgb8(linear, exposure)).save(path)
-    except (OSError, ValueError) as exc:
-        raise ShadeLabError(f"-o '{path}': cannot write image ({exc})") from None
+    """Write linear RGB (H, W, 3) as an sRGB image (PNG unless the extension says otherwise),
+    through a temporary file renamed when complete."""
+    with OutputSet() as out:
+        out.write("-o", path, _png_writer(path, linear, exposure))
 
 
 def write_npy(path: str, linear: np.ndarray) -> None:
-    """Write float32 linear radiance (H, W, 3), row 0 at the top."""
-    try:
-        np.save(path, np.ascontiguousarray(linear, dtype=np.float32))
-    except OSError as exc:
-        raise ShadeLabError(f"--npy '{path}': cannot write array ({exc.strerror})") from None
+    """Write float32 linear radiance (H, W, 3), row 0 at the top, to exactly ``path``."""
+    with OutputSet() as out:
+        out.write("--npy", path, _npy_writer(linear))
 
 
 def add_scene_arguments(parser: argparse.ArgumentParser, default_size: str = "800x600") -> None:
@@ -77,11 +86,27 @@ def add_scene_arguments(parser: argparse.ArgumentParser, default_size: str = "80
 
 
 def save_outputs(args: argparse.Namespace, image: np.ndarray, exposure: float = 1.0) -> None:
-    write_png(args.output, image, exposure)
-    if args.npy:
-        write_npy(args.npy, image)
+    """Write -o and --npy together: both are renamed into place only once both are written."""
+    with OutputSet() as out:
+        out.write("-o", args.output, _png_writer(args.output, image, exposure))
+        if args.npy:
+            out.write("--npy", args.npy, _npy_writer(image))
 
 
 def check_outputs(args: argparse.Namespace) -> None:
+    """-o and --npy can be written, differ from each other and from the input preset."""
     check_writable(args.output, "-o")
+    check_image_name(args.output, "-o")
     check_writable(args.npy, "--npy")
+    if args.npy and (same_file(args.output, args.npy) or
+                     Path(args.output).absolute() == Path(args.npy).absolute()):
+        raise ShadeLabError(f"--npy '{args.npy}': the same file as -o; choose another name")
+    preset = getattr(args, "preset", None)
+    if preset:
+        from shadelab.scene.preset import resolve_preset
+
+        source = resolve_preset(preset)
+        for flag, path in (("-o", args.output), ("--npy", args.npy)):
+            if path and same_file(path, source):
+                raise ShadeLabError(f"{flag} '{path}': is the input preset; writing it would "
+                                    "destroy the preset; choose another name")

@@ -81,6 +81,13 @@ def run_validate(args: argparse.Namespace) -> int:
         from shadelab.geometry.mesh import scene_meshes
 
         meshes = scene_meshes(scene)  # mesh files must load too
+        from shadelab.render.textures import BUMP_MODES, TEXTURE_MODES, check_image_file
+
+        for mname, m in scene.materials.items():  # and images be images within the limit
+            if m.texture not in TEXTURE_MODES:
+                check_image_file(m.texture, scene.base_dir, f"materials.{mname}.texture")
+            if m.bump not in BUMP_MODES:
+                check_image_file(m.bump, scene.base_dir, f"materials.{mname}.bump")
         triangles = sum(len(m.faces) for m in meshes)
         print(f"ok {name}: {len(scene.objects)} objects, {triangles} triangles, "
               f"{len(scene.lights)} lights")

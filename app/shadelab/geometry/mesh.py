@@ -17,7 +17,8 @@ from trimesh.transformations import euler_matrix
 
 from shadelab.errors import ShadeLabError
 from shadelab.geometry.normals import corner_normals, face_areas, face_normals
-from shadelab.scene.model import Object, Scene
+from shadelab.paths import file_problem
+from shadelab.scene.model import LENGTH_MAX, Object, Scene
 
 MESH_SUFFIXES = (".obj", ".ply", ".stl", ".gltf", ".glb", ".off")
 
@@ -173,11 +174,29 @@ def _projected_uvs(vertices: np.ndarray, shape: str) -> np.ndarray:
     return np.stack([(vertices[:, 0] - lo[0]) / span[0], (vertices[:, 2] - lo[2]) / span[2]], 1)
 
 
+def check_vertices(vertices: np.ndarray, where: str) -> None:
+    """Refuse NaN, infinite or out-of-range coordinates, naming the first bad vertex.
+
+    The limit is the field table's LENGTH_MAX: a mesh file may hold no coordinate a preset
+    could not (squared distances then stay finite in float32 shaders and in Embree).
+    """
+    with np.errstate(invalid="ignore"):
+        bad = ~np.isfinite(vertices).all(axis=1) | (np.abs(vertices) > LENGTH_MAX).any(axis=1)
+    if bad.any():
+        first = int(np.flatnonzero(bad)[0])
+        x, y, z = (float(c) for c in vertices[first])
+        what = "non-finite" if not np.isfinite(vertices[first]).all() else "out-of-range"
+        raise ShadeLabError(f"{where} has {int(bad.sum())} vertices with {what} coordinates, "
+                            f"first vertex {first} = ({x:g}, {y:g}, {z:g}); expected finite "
+                            f"numbers within +-{LENGTH_MAX:g}")
+
+
 def load_mesh_file(path: str, base_dir: str, key: str) -> trimesh.Trimesh:
     """Load a mesh file, refusing what no renderer can use, with a one-line reason."""
     full = Path(path) if Path(path).is_absolute() else Path(base_dir) / path
-    if not full.is_file():
-        raise ShadeLabError(f"{key}: mesh file '{full}' not found")
+    problem = file_problem(full)
+    if problem:
+        raise ShadeLabError(f"{key}: mesh file '{full}' {problem}")
     if full.suffix.lower() not in MESH_SUFFIXES:
         raise ShadeLabError(f"{key}: '{full.name}' is not a mesh file "
                             f"(expected one of {', '.join(MESH_SUFFIXES)})")
@@ -187,6 +206,7 @@ def load_mesh_file(path: str, base_dir: str, key: str) -> trimesh.Trimesh:
         raise ShadeLabError(f"{key}: '{full.name}' could not be read as a mesh ({exc})") from None
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         raise ShadeLabError(f"{key}: '{full.name}' holds no triangles (empty mesh)")
+    check_vertices(np.asarray(mesh.vertices, dtype=np.float64), f"{key}: '{full.name}'")
     areas = face_areas(np.asarray(mesh.vertices, float), np.asarray(mesh.faces))
     degenerate = np.flatnonzero(areas <= 1e-12 * max(float(areas.max()), 1e-300))
     if len(degenerate):

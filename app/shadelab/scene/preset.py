@@ -9,6 +9,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
+import os
 import reprlib
 import tomllib
 from pathlib import Path
@@ -17,6 +18,7 @@ from typing import Any
 import tomli_w
 
 from shadelab.errors import ShadeLabError
+from shadelab.paths import OutputSet, file_problem, output_problem, resolve_link
 from shadelab.resources import presets_dir
 from shadelab.scene.model import (
     MAX_LIGHTS,
@@ -77,7 +79,25 @@ def load_preset(name_or_path: str, overrides: list[str] | None = None) -> Scene:
     scene = scene_from_dict(raw, str(path))
     scene.name = path.stem
     scene.base_dir = str(path.resolve().parent)
+    check_files(scene, str(path))
     return scene
+
+
+def check_files(scene: Scene, source: str) -> None:
+    """Every mesh and image file the scene names is a readable regular file (no folder, FIFO,
+    symlink loop or too-long name); read later, it cannot fail for want of the file."""
+    base = Path(scene.base_dir)
+    named = [(f"objects.{i}.path", obj.path) for i, obj in enumerate(scene.objects)
+             if obj.shape == "mesh" and obj.path]
+    for name, m in scene.materials.items():
+        if m.texture and m.texture != "checker":
+            named.append((f"materials.{name}.texture", m.texture))
+        if m.bump and m.bump != "bumps":
+            named.append((f"materials.{name}.bump", m.bump))
+    for key, value in named:
+        problem = file_problem(Path(value) if Path(value).is_absolute() else base / value)
+        if problem:
+            raise ShadeLabError(f"{source}: key '{key}': file '{value}' {problem}")
 
 
 def read_toml(path: Path) -> dict:
@@ -397,14 +417,39 @@ def scene_to_dict(scene: Scene) -> dict:
 
 
 def save_preset(scene: Scene, path: str | Path) -> None:
-    """Write the scene as a TOML preset, through a temporary file so nothing is half-written."""
+    """Write the scene as a TOML preset, all or nothing (a unique temporary file, fsync,
+    rename). A read-only file is refused, not replaced; a symlink is written through (the
+    shared target changes, the link stays). Relative mesh and image paths are rebased on the
+    new folder, so the saved preset finds the same files."""
     path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    try:
-        tmp.write_text(tomli_w.dumps(scene_to_dict(scene)), encoding="utf-8")
-        tmp.replace(path)
-    except OSError as exc:
-        raise ShadeLabError(f"{path}: cannot write preset ({exc.strerror})") from None
+    problem = output_problem(path)
+    if problem:
+        raise ShadeLabError(f"{path}: cannot save the preset: {problem}")
+    text = tomli_w.dumps(_rebased(scene_to_dict(scene), Path(scene.base_dir),
+                                  resolve_link(path).absolute().parent))
+    with OutputSet() as out:
+        out.write("preset", path, lambda handle: handle.write(text.encode("utf-8")))
+
+
+def _rebased(data: dict, old_dir: Path, new_dir: Path) -> dict:
+    """Relative file paths of ``data`` (read from old_dir) made relative to new_dir."""
+    if old_dir.resolve() == new_dir.resolve():
+        return data
+
+    def rebase(value: str) -> str:
+        if not value or Path(value).is_absolute():
+            return value
+        return Path(os.path.relpath(old_dir.resolve() / value, new_dir.resolve())).as_posix()
+
+    for obj in data["objects"]:
+        if obj.get("shape") == "mesh":
+            obj["path"] = rebase(obj["path"])
+    for material in data["materials"].values():
+        if material["texture"] != "checker":
+            material["texture"] = rebase(material["texture"])
+        if material["bump"] != "bumps":
+            material["bump"] = rebase(material["bump"])
+    return data
 
 
 def clone_scene(scene: Scene) -> Scene:

@@ -1,0 +1,176 @@
+"""Files the user names: why one cannot be read, and writing outputs all-or-nothing.
+
+Pure standard library, so every layer may use it. Reading: :func:`file_problem` turns what
+``stat`` says (missing, a folder, a FIFO, a symlink loop, a name too long) into the few words
+of a one-line error. Writing: :class:`OutputSet` writes each output of a run to a unique
+temporary file beside its target, fsyncs it and renames them all only once every one was
+written, so a failed or interrupted run leaves nothing half-written and no stray file; an
+existing target keeps its permission bits, and a symlink target is written through (the file
+it points at is replaced, the link stays a link).
+"""
+
+from __future__ import annotations
+
+import errno
+import os
+import stat
+import tempfile
+from pathlib import Path
+from typing import Callable
+
+from shadelab.errors import ShadeLabError
+
+
+def _reason(exc: OSError) -> str:
+    if exc.errno == errno.ENOENT:
+        return "not found"
+    if exc.errno == errno.ELOOP:
+        return "is a symlink loop"
+    if exc.errno == errno.ENAMETOOLONG:
+        return "has a name too long for the file system"
+    if exc.errno == errno.ENOTDIR:
+        return "has a file where a folder is expected"
+    return exc.strerror or type(exc).__name__
+
+
+def file_problem(path: str | Path) -> str | None:
+    """None if ``path`` is a readable regular file, else why not ("not found", ...)."""
+    if "\n" in str(path) or "\r" in str(path):
+        return "has a line break in its name"
+    try:
+        info = os.stat(path)
+    except (OSError, ValueError) as exc:
+        return _reason(exc) if isinstance(exc, OSError) else "is not a valid path"
+    if stat.S_ISDIR(info.st_mode):
+        return "is a folder, expected a file"
+    if not stat.S_ISREG(info.st_mode):
+        return "is not a regular file (a FIFO, socket or device)"
+    if not os.access(path, os.R_OK):
+        return "is not readable (permission denied)"
+    return None
+
+
+def output_problem(path: str | Path) -> str | None:
+    """None if a file can be written at ``path`` (nothing is created), else why not."""
+    text = str(path)
+    if not text:
+        return "is empty"
+    if "\n" in text or "\r" in text or "\x00" in text:
+        return "has a line break or NUL in its name"
+    target = Path(path)
+    if len(os.fsencode(target.name)) > 255:
+        return "has a name too long for the file system"
+    try:
+        info = os.stat(target)  # follows links: a loop or a too-long name says so here
+    except FileNotFoundError:
+        info = None
+        if target.is_symlink():  # dangling: written through to where the link points
+            target = resolve_link(target)
+    except OSError as exc:
+        return _reason(exc)
+    if info is not None:
+        if stat.S_ISDIR(info.st_mode):
+            return "is a folder, expected a file name"
+        if not stat.S_ISREG(info.st_mode):
+            return "is not a regular file (a FIFO, socket or device)"
+        if not info.st_mode & 0o222:  # the user's own "keep this": respected even by root
+            return "is read-only (not writable; make it writable or choose another name)"
+    folder = target.parent
+    try:
+        folder_info = os.stat(folder)
+    except FileNotFoundError:
+        return f"folder '{folder.resolve()}' does not exist"
+    except OSError as exc:
+        return f"folder '{folder}' {_reason(exc)}"
+    if not stat.S_ISDIR(folder_info.st_mode):
+        return f"'{folder}' is not a folder"
+    try:  # the real test: a temporary file there (what the write will make), removed again
+        fd, probe = tempfile.mkstemp(prefix=".shadelab-probe.", dir=folder)
+    except OSError as exc:
+        return f"not writable (folder '{folder}': {exc.strerror})"
+    os.close(fd)
+    os.unlink(probe)
+    return None
+
+
+def resolve_link(path: Path) -> Path:
+    """Where a (possibly dangling) symlink chain ends; the path itself if it is no link."""
+    seen = 0
+    while path.is_symlink():
+        seen += 1
+        if seen > 40:
+            raise ShadeLabError(f"'{path}': symlink loop")
+        link = Path(os.readlink(path))
+        path = link if link.is_absolute() else path.parent / link
+    return path
+
+
+def same_file(a: str | Path, b: str | Path) -> bool:
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
+class OutputSet:
+    """Outputs of one run, written to temporary files and renamed only all together.
+
+    >>> with OutputSet() as out:                           # doctest: +SKIP
+    ...     out.write("-o", "a.png", lambda f: image.save(f, format="PNG"))
+    ...     out.write("--npy", "a.npy", lambda f: np.save(f, array))
+    On an exception (Ctrl+C included) every temporary file is removed and no target changes.
+    """
+
+    def __init__(self) -> None:
+        self._staged: list[tuple[str, Path, Path]] = []  # (flag, temporary, final target)
+
+    def __enter__(self) -> OutputSet:
+        return self
+
+    def write(self, flag: str, path: str | Path, writer: Callable) -> None:
+        """Stage one output: ``writer(binary_file)`` writes its bytes."""
+        target = resolve_link(Path(path))
+        fd, tmp = tempfile.mkstemp(prefix=f".{target.name[:200]}.", suffix=".tmp",
+                                   dir=target.parent)
+        tmp_path = Path(tmp)
+        self._staged.append((flag, tmp_path, target))
+        try:
+            with os.fdopen(fd, "wb") as handle:
+                writer(handle)
+                handle.flush()
+                os.fsync(handle.fileno())
+        except OSError as exc:
+            raise ShadeLabError(f"{flag} '{path}': cannot write ({exc.strerror or exc}); "
+                                "nothing was written") from None
+        try:  # keep an existing file's permission bits (mkstemp makes 0600)
+            mode = stat.S_IMODE(os.stat(target).st_mode)
+        except OSError:
+            umask = os.umask(0)
+            os.umask(umask)
+            mode = 0o666 & ~umask
+        os.chmod(tmp_path, mode)
+
+    def commit(self) -> None:
+        for flag, tmp, target in self._staged:
+            try:
+                os.replace(tmp, target)
+            except OSError as exc:
+                raise ShadeLabError(f"{flag} '{target}': cannot write ({exc.strerror})") from None
+        self._staged.clear()
+
+    def discard(self) -> None:
+        for _flag, tmp, _target in self._staged:
+            try:
+                tmp.unlink()
+            except OSError:
+                pass
+        self._staged.clear()
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        if exc_type is None:
+            try:
+                self.commit()
+            finally:
+                self.discard()
+        else:
+            self.discard()
