@@ -40,6 +40,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    "at start (shading, raytrace, radiosity, shadows); --frames counts after it")
     p.add_argument("--gallery", metavar="CASE", help="select this failure-gallery case and open "
                    "it in the viewer at start (e.g. gouraud-highlight)")
+    p.add_argument("--pipeline", metavar="NAME",
+                   help="start the viewport in this pipeline: gouraud, phong, painter, "
+                        "radiosity, raytrace, pathtrace")
     p.add_argument("--presenter", action="store_true", help="large fonts for a projector")
     p.add_argument("--wireframe", action="store_true", help="show the wireframe")
     p.add_argument("--normals", action="store_true", help="show normal glyphs")
@@ -103,6 +106,12 @@ def run_view(args: argparse.Namespace) -> int:
     if args.frames < 0:
         raise ShadeLabError(f"--frames {args.frames}: expected a count >= 0")
     _check_study_and_case(args)
+    if args.pipeline:
+        from shadelab.ui.pipeline_jobs import PIPELINE_NAMES
+
+        if args.pipeline not in PIPELINE_NAMES:
+            raise ShadeLabError(f"--pipeline '{args.pipeline}': expected one of "
+                                f"{', '.join(PIPELINE_NAMES)}")
     scene, source, restored = load_scene(args)
     from shadelab.geometry.mesh import scene_meshes
 
@@ -121,5 +130,5 @@ def run_view(args: argparse.Namespace) -> int:
                             bench_json=args.bench_json or "", autosave=not args.no_autosave,
                             show_radiosity=args.show_radiosity, ray_tree=ray_tree,
                             focus=args.focus or "", study=args.study or "",
-                            gallery=args.gallery or "")
+                            gallery=args.gallery or "", pipeline=args.pipeline or "")
     return run_viewer(state, options)

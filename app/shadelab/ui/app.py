@@ -20,10 +20,11 @@ from imgui_bundle import hello_imgui, imgui, immapp
 
 from shadelab.geometry.mesh import geometry_key, scene_meshes
 from shadelab.scene.model import Camera
-from shadelab.ui import overlays, panels
+from shadelab.ui import overlays, panels, pipelines
 from shadelab.ui.frame import guarded
 from shadelab.ui.offline import draw_offline_panel
 from shadelab.ui.probe import probe
+from shadelab.ui.render_panel import draw_algorithms_panel
 from shadelab.ui.state import (
     AUTOSAVE_INTERVAL,
     COMPARE_LABELS,
@@ -58,6 +59,7 @@ class ViewerOptions:
     focus: str = ""                       # dock windows brought to front at start (a,b,...)
     study: str = ""                       # study run (quick) at start; --frames counts after it
     gallery: str = ""                     # failure-gallery case selected and opened at start
+    pipeline: str = ""                    # viewport pipeline at start (shadelab.ui.pipelines)
     test_function: Callable | None = None  # immapp.testing test body (GUI tests)
 
 
@@ -238,6 +240,8 @@ class Viewer:
             from shadelab.ui.offline import start_job_by_label
 
             start_job_by_label(self.state, self.options.job)
+        if self.options.pipeline:
+            pipelines.set_pipeline(self.state, self.options.pipeline)
 
     def _open_gallery_case(self, name: str) -> None:
         from shadelab.studies.gallery import GALLERY
@@ -252,6 +256,8 @@ class Viewer:
 
     def before_exit(self) -> None:
         self.state.job.shutdown()
+        if self.state.pipeline_view is not None and self.state.pipeline_view.runner is not None:
+            self.state.pipeline_view.runner.shutdown()
         if self.state.study is not None:
             self.state.study.shutdown()
         if self.options.autosave:
@@ -331,6 +337,8 @@ class Viewer:
     def draw_main(self, size: tuple[int, int]) -> None:
         state, vp = self.state, self.viewport
         scene = state.scene
+        if pipelines.draw(self, size):  # an offline pipeline or the wipe took the viewport
+            return
         display_size, size = size, self.render_size(size)
         if "main" in vp.panes and self.unchanged(size):
             self._handle_click(self._image_with_input(vp.panes["main"].display, display_size),
@@ -552,6 +560,7 @@ class Viewer:
             self.force_interactive = state.frame >= 2 * third
         waiting = self.options.job and (state.job.running or not state.job.started
                                         or state.job_version != state.job.version)
+        waiting = waiting or bool(self.options.pipeline and pipelines.busy(state))
         if state.study is not None:
             state.study.poll()  # also while the Studies tab is hidden
             if self.options.study and not self._study_done_at and not state.study.running:
@@ -617,6 +626,7 @@ class Viewer:
                 report[f"{name}_frame_ms_median"] = float(np.median(picked))
                 report[f"{name}_frame_ms_max"] = float(np.max(picked))
                 report[f"{name}_cpu_ms_median"] = float(np.median(picked_cpu))
+        report.update(pipelines.bench_report(self.state))  # jobs: first_image_s, done_s
         Path(self.options.bench_json).write_text(json.dumps(report), encoding="utf-8")
 
     def first_frame_since_start(self) -> float:
@@ -664,6 +674,7 @@ def _docking(viewer: Viewer) -> hello_imgui.DockingParams:
         window("Studies", "RightSpace", p(draw_studies_panel)),
         window("Failure gallery", "RightSpace", p(draw_gallery_panel)),
         window("Offline render", "RightBottom", p(draw_offline_panel)),
+        window("Algorithms", "LeftSpace", p(draw_algorithms_panel)),
     ]
     for w in params.dockable_windows:
         # llvmpipe is fill-bound: the window clear (same color) replaces every panel's
@@ -735,6 +746,9 @@ def runner_params(viewer: Viewer) -> hello_imgui.RunnerParams:
 def run_viewer(state: AppState, options: ViewerOptions) -> int:
     """Open the window and run until it is closed (or ``options.frames`` frames)."""
     viewer = Viewer(state, options)
+    if options.test_function is None:
+        state.pipeline = options.pipeline or state.pipeline
+        pipelines.warm(state)  # the job process spawns (and loads its kernels) as the window opens
     params = runner_params(viewer)
     addons = immapp.AddOnsParams(with_implot=True)
     if options.test_function is not None:

@@ -136,6 +136,9 @@ def draw_file_panel(state: AppState) -> bool:
 def draw_render_panel(state: AppState) -> bool:
     """Shading mode, specular model, exposure, ambient, overlays."""
     scene, edited = state.scene, False
+    from shadelab.ui.render_panel import draw_pipeline_selector
+
+    draw_pipeline_selector(state)
     imgui.text("Shading")
     for mode in SHADING_MODES:
         imgui.same_line()
@@ -256,8 +259,8 @@ def _new_light(state: AppState) -> Light:
 
 _M = field_slider(Material)  # ranges from the model's field table (shadelab.ui.ranges)
 MATERIAL_ROWS = [("ka", _M), ("kd", _M), ("ks", _M), ("n", _M), ("Od", _color), ("Os", _color)]
-MATERIAL_MORE_ROWS = [("kt", _M), ("Ot", _color), ("kr", _M), ("ior", _M),
-                      ("emission", _intensity_color)]
+MATERIAL_MORE_ROWS = [("emission", _intensity_color)]  # kt, Ot, kr, ior, texture, bump:
+#                                    shadelab.ui.render_panel.draw_material_extras
 
 
 def draw_materials_panel(state: AppState) -> bool:
@@ -268,6 +271,9 @@ def draw_materials_panel(state: AppState) -> bool:
         if imgui.tree_node_ex(name, imgui.TreeNodeFlags_.default_open if i == 0 else 0):
             edited |= _edit_fields(material, MATERIAL_ROWS)
             if imgui.tree_node("transparency, reflection, emission"):
+                from shadelab.ui.render_panel import draw_material_extras
+
+                edited |= draw_material_extras(material)
                 edited |= _edit_fields(material, MATERIAL_MORE_ROWS)
                 imgui.tree_pop()
             imgui.tree_pop()

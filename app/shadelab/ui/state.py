@@ -160,6 +160,14 @@ class AppState:
     radiosity_soup: Any = None        # (3F, 6) float32 solved display triangles (radiance)
     show_radiosity: bool = False      # draw the radiosity solution instead of the raster
     overlay_version: int = 0          # bumped when the ray tree or radiosity solution changes
+    # Viewport pipeline (shadelab.ui.pipelines): gouraud, phong, painter, radiosity, raytrace,
+    # pathtrace; "" = the raster pipeline the scene's shading and visibility name
+    pipeline: str = ""
+    wipe: bool = False                # compare the pipeline with wipe_pipeline under one camera
+    wipe_pipeline: str = "raytrace"
+    wipe_position: float = 0.5        # share of the viewport's width left of the wipe line
+    radiosity_patches: bool = False   # radiosity pipeline: draw the patch edges
+    pipeline_view: Any = None         # shadelab.ui.pipelines.PipelineView (jobs, images)
     # Studies and failure gallery panels (shadelab.ui.studies_panel)
     study: Any = None                 # shadelab.ui.studies.StudyRun, made on first use
     study_index: int = 0              # into shadelab.studies.STUDIES

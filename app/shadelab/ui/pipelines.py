@@ -1,0 +1,570 @@
+"""The lecture's pipelines as a viewport mode, and the wipe that compares two of them.
+
+``state.pipeline`` names one of :data:`PIPELINES`. The raster ones (z-buffer + Gouraud,
+z-buffer + Phong, list priority + Phong) set the scene's shading and visibility (an edit, so
+undo brings the last one back). The offline ones draw into the main viewport at its
+resolution: ray and path tracing coarse first (1/8, 1/4, 1/2, full) and refined in place,
+radiosity shot by shot as Gouraud triangles under the live camera. Any edit the image depends
+on restarts the job from coarse: the running one is cancelled without waiting, the new one
+starts on the first frame the worker is free, and until its first image arrives the last
+image stays up. Jobs run in a worker process of their own (:class:`shadelab.ui.jobs.JobRunner`),
+so the UI never waits for them.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from imgui_bundle import imgui
+
+from shadelab.scene.preset import clone_scene
+from shadelab.ui import pipeline_jobs
+from shadelab.ui.state import AppState
+
+PIPELINES = pipeline_jobs.PIPELINE_NAMES
+LABELS = {"gouraud": "z-buffer + Gouraud", "phong": "z-buffer + Phong",
+          "painter": "list priority + Phong", "radiosity": "radiosity + Gouraud",
+          "raytrace": "ray tracing (Whitted)", "pathtrace": "path tracing (reference)"}
+RASTER = {"gouraud": ("gouraud", "zbuffer"), "phong": ("phong", "zbuffer"),
+          "painter": ("phong", "painter")}
+OFFLINE = {"raytrace": pipeline_jobs.pipeline_raytrace,
+           "pathtrace": pipeline_jobs.pipeline_pathtrace,
+           "radiosity": pipeline_jobs.pipeline_radiosity}
+RAY_COLORS = {"primary": 0xFFFFFFFF, "reflected": 0xFF30D0FF, "refracted": 0xFFFFB040,
+              "shadow": 0xFF40FF40, "blocked": 0xFF4040FF}   # ImGui ABGR
+SHOOTER_COLOR = (1.0, 0.9, 0.1)
+PATCH_EDGE_COLOR = (0.02, 0.02, 0.02)
+
+
+def _process_start() -> float:
+    """perf_counter() at this process's start (Linux /proc; else this module's import)."""
+    try:
+        ticks = os.sysconf("SC_CLK_TCK")
+        start = int(Path("/proc/self/stat").read_text().rsplit(")", 1)[1].split()[19]) / ticks
+        uptime = float(Path("/proc/uptime").read_text().split()[0])
+        return time.perf_counter() - (uptime - start)
+    except (OSError, ValueError, IndexError):
+        return time.perf_counter()
+
+
+PROCESS_START = _process_start()
+
+
+def since_start(t: float) -> float:
+    return round(t - PROCESS_START, 3)
+
+
+@dataclass
+class JobRecord:
+    """One job's figures for ``--bench-json``: seconds from process start."""
+
+    name: str
+    size: tuple
+    started_s: float
+    first_image_s: float | None = None
+    done_s: float | None = None
+    reused_form_factors: bool | None = None
+
+    def as_dict(self) -> dict:
+        return {"name": self.name, "size": list(self.size), "started_s": self.started_s,
+                "first_image_s": self.first_image_s, "done_s": self.done_s,
+                **({} if self.reused_form_factors is None
+                   else {"form_factors_reused": self.reused_form_factors})}
+
+
+@dataclass
+class PipelineView:
+    """The viewport pipeline's job, its latest image or triangles, and what it was made of."""
+
+    runner: object = None                # shadelab.ui.jobs.JobRunner (its own worker)
+    applied: str = ""                    # the raster pipeline last written into the scene
+    key: object = None                   # what the running/wanted job renders
+    wanted: tuple | None = None          # (name, scene, size) waiting for the worker
+    name: str = ""                       # pipeline of the current job
+    job_scene: object = None
+    job_size: tuple = (0, 0)
+    version: int = -1
+    image_size: tuple = (0, 0)           # the latest image's (w, h) (coarse levels: smaller)
+    soup: np.ndarray | None = None
+    shooter: np.ndarray | None = None
+    stats: dict = field(default_factory=dict)
+    message: str = ""
+    history: dict = field(default_factory=dict)
+    log: list = field(default_factory=list)     # JobRecord per job (viewport and side panel)
+    offline_seen: int = -1                      # the side panel's job already logged
+    frame_times: list = field(default_factory=list)   # frames drawn while a job refines
+    ray_tree: object = None
+    ray_tree_pixel: tuple | None = None
+    tree_depth: int = 99                 # ray-tree generations shown
+    raster_key: dict = field(default_factory=dict)
+    warm_started: bool = False
+    record: object = None                # JobRecord of the viewport's current job
+    linear: object = None                # the latest offline image, linear (H, W, 3)
+    _offline_record: object = None
+    step_mode: bool = False              # radiosity: shots come one press of "Step" at a time
+    paused: bool = False
+
+    def ensure_runner(self):
+        if self.runner is None:
+            from shadelab.ui.jobs import JobRunner
+
+            self.runner = JobRunner()
+        return self.runner
+
+
+def view_of(state: AppState) -> PipelineView:
+    if state.pipeline_view is None:
+        state.pipeline_view = PipelineView()
+    return state.pipeline_view
+
+
+def current(state: AppState) -> str:
+    """The pipeline shown: ``state.pipeline``, or the raster one the scene's settings name."""
+    if state.pipeline in PIPELINES:
+        return state.pipeline
+    render = state.scene.render
+    if render.visibility == "painter":
+        return "painter"
+    return "gouraud" if render.shading == "gouraud" else "phong"
+
+
+def set_pipeline(state: AppState, name: str) -> None:
+    """Switch the viewport's pipeline (the panel, the CLI's --pipeline and lessons call it)."""
+    if name not in PIPELINES:
+        state.error = f"pipeline '{name}': expected one of {', '.join(PIPELINES)}"
+        return
+    state.pipeline = name
+    sync(state)
+
+
+def sync(state: AppState) -> None:
+    """Write a newly chosen raster pipeline into the scene (once per choice)."""
+    view = view_of(state)
+    name = state.pipeline
+    if name in RASTER and view.applied != name:
+        shading, visibility = RASTER[name]
+        render = state.scene.render
+        if (render.shading, render.visibility) != (shading, visibility):
+            render.shading, render.visibility = shading, visibility
+            state.mark_edited()
+    view.applied = name
+
+
+# ---------------------------------------------------------------- jobs
+
+
+def job_key(state: AppState, name: str, size: tuple[int, int]) -> tuple:
+    """What an offline image depends on: radiosity is view-independent (no camera, no size)."""
+    scene = state.scene
+    if name == "radiosity":
+        return (name, repr(scene.objects), repr(scene.materials), repr(scene.radiosity),
+                scene.base_dir)
+    spp = state.job_spp if name == "pathtrace" else scene.raytrace.spp
+    return (name, repr(scene), size, spp)
+
+
+def scene_for(state: AppState, name: str):
+    scene = clone_scene(state.scene)
+    if name == "pathtrace":
+        scene.raytrace.spp = max(int(state.job_spp), 1)
+    return scene
+
+
+def poll(state: AppState, name: str, size: tuple[int, int]) -> None:
+    """Restart the job when what it renders changed; take its newest result."""
+    view = view_of(state)
+    runner = view.ensure_runner()
+    key = job_key(state, name, size)
+    if key != view.key:
+        view.key = key
+        view.wanted = (name, scene_for(state, name), size)
+        view.ray_tree = None
+        if view.name != "warm-up":       # (a cancelled warm-up would be killed mid-compile)
+            runner.cancel()              # no wait: the new job starts once this one stops
+    if view.wanted is not None and not runner.running and not view.paused:
+        _start(state, *view.wanted)
+        view.wanted = None
+    _take(state)
+
+
+def _start(state: AppState, name: str, scene, size) -> None:
+    view = view_of(state)
+    factory = OFFLINE[name]
+    if view.record is not None and view.record.done_s is None:
+        view.record.done_s = since_start(view.runner.finished or time.perf_counter())
+    view.name, view.job_scene, view.job_size = name, scene, size
+    view.version = -1
+    view.record = JobRecord(f"viewport {name}", tuple(size), since_start(time.perf_counter()))
+    view.log.append(view.record)
+    if name == "radiosity" and view.step_mode:
+        gate = _StepGate(view.runner._cancel)
+        view.stats["gate"] = gate
+        view.runner.start(name, lambda: gate.wrap(factory(scene, size, step_shots=1)))
+    else:
+        view.runner.start(name, lambda: factory(scene, size), call=(factory, scene, size))
+
+
+class _StepGate:
+    """Runs a radiosity job one shot per :meth:`step` (a thread job; the UI presses Step)."""
+
+    def __init__(self, cancelled) -> None:
+        import threading
+
+        self.allowed = threading.Semaphore(1)
+        self.cancelled = cancelled          # the runner's cancel event
+
+    def step(self) -> None:
+        self.allowed.release()
+
+    def wrap(self, gen):
+        for item in gen:
+            while not self.allowed.acquire(timeout=0.05):
+                if self.cancelled.is_set():
+                    return
+            yield item
+
+
+def _take(state: AppState) -> None:
+    view = view_of(state)
+    latest, version = view.runner.snapshot()
+    record = view.record
+    if record is not None and record.done_s is None and view.runner.started \
+            and not view.runner.running:
+        record.done_s = since_start(view.runner.finished or time.perf_counter())
+    if latest is None or version == view.version:
+        return
+    view.version = version
+    view.message = latest.message
+    stats = latest.stats or {}
+    view.stats = {k: v for k, v in stats.items() if k not in ("soup", "history")} \
+        | ({"gate": view.stats["gate"]} if "gate" in view.stats else {})
+    if "history" in stats:
+        view.history = stats["history"]
+    got_image = False
+    if latest.image is not None and state.gl is not None:
+        from shadelab.shading.conventions import to_srgb8
+
+        image = np.asarray(latest.image, np.float32)
+        srgb = to_srgb8(image, state.scene.render.exposure)
+        state.gl.upload_image("pipeline", np.ascontiguousarray(srgb[::-1]))  # bottom-up
+        view.image_size = (image.shape[1], image.shape[0])
+        view.linear = image
+        got_image = True
+    if "soup" in stats:
+        view.soup = stats["soup"]
+        view.shooter = stats.get("shooter")
+        got_image = True
+    if record is not None and got_image and record.first_image_s is None:
+        record.first_image_s = since_start(time.perf_counter())
+    if record is not None and "form_factors_reused" in stats:
+        record.reused_form_factors = bool(stats["form_factors_reused"])
+
+
+def track_side_panel_job(state: AppState) -> None:
+    """Log the offline panel's job (``--job NAME``) for ``--bench-json`` too."""
+    view, job = view_of(state), state.job
+    if job is None or not job.started:
+        return
+    if view.offline_seen != job._job_id:
+        view.offline_seen = job._job_id
+        view.log.append(JobRecord(job.name, tuple(state.job_size_px),
+                                  since_start(job.started)))
+        view._offline_record = view.log[-1]
+    record = view._offline_record
+    latest, _ = job.snapshot()
+    if record.first_image_s is None and latest is not None and latest.image is not None:
+        record.first_image_s = since_start(time.perf_counter())
+    if record.done_s is None and not job.running:
+        record.done_s = since_start(job.finished or time.perf_counter())
+
+
+def busy(state: AppState) -> bool:
+    """An offline pipeline is still refining (``--frames`` counts after it)."""
+    view = state.pipeline_view
+    if view is None or state.pipeline not in OFFLINE or view.runner is None:
+        return False
+    return view.wanted is not None or view.runner.running or view.version < 0
+
+
+def warm(state: AppState) -> None:
+    """Compile or load the offline kernels in the pipeline worker (viewer start-up)."""
+    view = view_of(state)
+    if view.warm_started:
+        return
+    view.warm_started = True
+    runner = view.ensure_runner()
+    if runner.worker is not None:
+        runner.worker.ensure()   # spawn now: the process imports while the window opens
+    if state.pipeline in OFFLINE:
+        return                   # that pipeline's first job is its own warm-up
+    scene = clone_scene(state.scene)
+    view.name = "warm-up"
+    view.record = JobRecord("warm-up", (8, 8), since_start(time.perf_counter()))
+    view.log.append(view.record)
+    runner.start("warm-up", lambda: pipeline_jobs.warm_kernels(scene, None),
+                 call=(pipeline_jobs.warm_kernels, scene, None))
+
+
+def bench_report(state: AppState) -> dict:
+    """``jobs`` (name, first_image_s, done_s from process start) and the refining fps."""
+    view = state.pipeline_view
+    if view is None:
+        return {}
+    track_side_panel_job(state)
+    report: dict = {"jobs": [r.as_dict() for r in view.log]}
+    times = np.diff(np.asarray(view.frame_times)) if len(view.frame_times) > 2 else []
+    if len(times):
+        report["refining_fps_median"] = float(1.0 / np.median(times))
+        report["refining_frames"] = len(view.frame_times)
+    return report
+
+
+# ---------------------------------------------------------------- drawing
+
+
+def draw(viewer, display_size: tuple[int, int]) -> bool:
+    """The main viewport in an offline pipeline or with the wipe; False: the raster path."""
+    state = viewer.state
+    view = view_of(state)
+    sync(state)
+    track_side_panel_job(state)
+    name = current(state)
+    wipe = state.wipe and state.wipe_pipeline in PIPELINES and state.wipe_pipeline != name
+    if name not in OFFLINE and not wipe:
+        if view.runner is not None and view.runner.running and view.name in OFFLINE:
+            view.runner.cancel()
+        view.key = None
+        return False
+    scale = state.render_scale
+    size = (max(int(display_size[0] * scale), 8), max(int(display_size[1] * scale), 8))
+    if state.frame < 3:     # the dock layout settles over the first frames: no job at 16x16
+        return True
+    other = state.wipe_pipeline if wipe else None
+    offline = [n for n in (name, other) if n in OFFLINE]
+    if offline:
+        poll(state, offline[0], size)
+        if view.runner.running:
+            view.frame_times.append(time.perf_counter())
+    elif view.runner is not None and view.runner.running and view.name in OFFLINE:
+        view.runner.cancel()
+        view.key = None
+    tex_a = _texture(viewer, name, size, offline)
+    origin = imgui.get_cursor_screen_pos()
+    clicked = viewer._image_with_input(tex_a, display_size) if tex_a is not None else None
+    draw_list = imgui.get_window_draw_list()
+    if tex_a is None:
+        imgui.set_cursor_screen_pos(origin)
+        clicked = viewer._image_with_input(_blank(viewer), display_size)
+    if wipe:
+        tex_b = _texture(viewer, other, size, offline)
+        x = origin.x + state.wipe_position * display_size[0]
+        if tex_b is not None:
+            draw_list.add_image(imgui.ImTextureRef(tex_b.glo), imgui.ImVec2(x, origin.y),
+                                imgui.ImVec2(origin.x + display_size[0],
+                                             origin.y + display_size[1]),
+                                imgui.ImVec2(state.wipe_position, _v(other, 0)),
+                                imgui.ImVec2(1.0, _v(other, 1)))
+        draw_list.add_line(imgui.ImVec2(x, origin.y), imgui.ImVec2(x, origin.y + display_size[1]),
+                           0xFFFFFFFF, 3.0)
+        _label(draw_list, imgui.ImVec2(origin.x + 8, origin.y + display_size[1] - 28),
+               LABELS[name])
+        _label(draw_list, imgui.ImVec2(x + 8, origin.y + display_size[1] - 28), LABELS[other])
+    if name == "raytrace" and view.ray_tree is not None:
+        draw_ray_tree(state, draw_list, origin, display_size)
+    _label(draw_list, imgui.ImVec2(origin.x + 8, origin.y + 8), status_line(state))
+    if clicked is not None:
+        _clicked(state, name, clicked, display_size)
+    if state.screenshot_requested:
+        _screenshot_pipeline(viewer, tex_a)
+    return True
+
+
+def _v(name: str, end: int) -> float:
+    """The texture's v at the top (end 0) / bottom (1): GL panes are bottom-up, and the
+    offline images are uploaded bottom-up too, so one image call shows them all."""
+    return 1.0 - end
+
+
+def _blank(viewer):
+    vp = viewer.viewport
+    if "pipeline_blank" not in vp.images:
+        vp.upload_image("pipeline_blank", np.zeros((8, 8, 3), np.uint8))
+    return vp.images["pipeline_blank"]
+
+
+def _texture(viewer, name: str, size: tuple[int, int], offline: list):
+    """The display texture of pipeline ``name`` (raster: rendered now if its inputs changed)."""
+    state, vp = viewer.state, viewer.viewport
+    view = view_of(state)
+    exposure = state.scene.render.exposure
+    if name in ("raytrace", "pathtrace"):
+        if offline and offline[0] != name:
+            return None
+        if view.name != name and view.version < 0:
+            return None
+        return vp.images.get("pipeline")
+    if name == "radiosity":
+        if view.soup is None or view.name != "radiosity":
+            return None
+        pane = vp.pane("pipeline_radiosity", size)
+        vp.draw_colored_triangles(pane, state.scene, view.soup)
+        if state.show_wireframe or state.radiosity_patches:
+            vp.draw_lines(pane, patch_edges(view.soup), exposure)
+        if view.shooter is not None and not view.stats.get("done"):
+            vp.draw_lines(pane, shooter_lines(view.shooter), exposure, depth_test=False)
+        return vp.present(pane, exposure)
+    shading, visibility = RASTER[name]
+    key = (repr(state.scene), size, name)
+    pane_key = f"pipeline_{name}"
+    if view.raster_key.get(name) != key or pane_key not in vp.panes:
+        view.raster_key[name] = key
+        scene = state.scene
+        if (scene.render.shading, scene.render.visibility) != (shading, visibility):
+            scene = clone_scene(scene)
+            scene.render.shading, scene.render.visibility = shading, visibility
+        pane = vp.draw_scene(pane_key, scene, size, shading, scene.render.specular)
+        vp.present(pane, exposure)
+    return vp.panes[pane_key].display
+
+
+def patch_edges(soup: np.ndarray) -> np.ndarray:
+    """Each display triangle's edges (the patches: two triangles per quad patch, the
+    diagonal included) as dark segments."""
+    tri = soup[:, :3].reshape(-1, 3, 3)
+    starts = tri.reshape(-1, 3)
+    ends = np.roll(tri, -1, axis=1).reshape(-1, 3)
+    out = np.empty((len(starts), 2, 6), np.float32)
+    out[:, 0, :3], out[:, 1, :3], out[:, :, 3:] = starts, ends, PATCH_EDGE_COLOR
+    return out.reshape(-1, 6)
+
+
+def shooter_lines(polygon: np.ndarray) -> np.ndarray:
+    """The shooting patch's outline and diagonals, bright yellow."""
+    p = np.asarray(polygon, np.float32)
+    pairs = [(0, 1), (1, 2), (2, 3), (3, 0), (0, 2), (1, 3)]
+    out = np.empty((len(pairs), 2, 6), np.float32)
+    for k, (a, b) in enumerate(pairs):
+        out[k, 0, :3], out[k, 1, :3] = p[a], p[b]
+    out[:, :, 3:] = np.asarray(SHOOTER_COLOR) * 1e3   # bright at any exposure (clamped)
+    return out.reshape(-1, 6)
+
+
+def _label(draw_list, pos, text: str) -> None:
+    size = imgui.calc_text_size(text)
+    draw_list.add_rect_filled(imgui.ImVec2(pos.x - 4, pos.y - 2),
+                              imgui.ImVec2(pos.x + size.x + 4, pos.y + size.y + 2), 0xB0000000)
+    draw_list.add_text(pos, 0xFFFFFFFF, text)
+
+
+def status_line(state: AppState) -> str:
+    view = view_of(state)
+    name = current(state)
+    if name not in OFFLINE:
+        return LABELS[name]
+    runner = view.runner
+    word = "refining" if runner is not None and runner.running else ""
+    if view.wanted is not None:
+        word = "restarting"
+    if runner is not None and runner.error:
+        word = f"failed: {runner.error}"
+    elapsed = runner.elapsed if runner is not None else 0.0
+    return f"{LABELS[name]}: {word}  {view.message}  {elapsed:.1f} s"
+
+
+def _clicked(state: AppState, name: str, pixel, display_size) -> None:
+    """A click in the ray-traced viewport picks that pixel's ray tree."""
+    view = view_of(state)
+    if name != "raytrace" or view.job_scene is None:
+        return
+    w, h = view.job_size
+    x = min(int(pixel[0] * w / display_size[0]), w - 1)
+    y = min(int(pixel[1] * h / display_size[1]), h - 1)
+    try:
+        from shadelab.raytrace.tree import trace_pixel_tree
+
+        view.ray_tree = trace_pixel_tree(view.job_scene, (w, h), x, y)
+        view.ray_tree_pixel = (x, y)
+        view.tree_depth = 99
+    except Exception as exc:  # shown in the app; the session goes on
+        state.error = f"ray tree of pixel {(x, y)}: {exc}"
+
+
+def project(scene, size: tuple[int, int], points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Screen (x, y) in [0, size] of world points and whether each is in front of the eye."""
+    from shadelab.scene.camera import camera_basis
+
+    forward, right, up = camera_basis(scene.camera)
+    rel = np.asarray(points, float) - np.asarray(scene.camera.eye, float)
+    z = rel @ forward
+    tan_half = np.tan(np.radians(scene.camera.fov_y) / 2.0)
+    aspect = size[0] / max(size[1], 1)
+    zs = np.maximum(z, 1e-9)
+    x = (rel @ right) / (zs * tan_half * aspect)
+    y = (rel @ up) / (zs * tan_half)
+    return np.stack([(x + 1) * 0.5 * size[0], (1 - y) * 0.5 * size[1]], axis=1), z > 0
+
+
+def tree_segments(root, miss_length: float, max_depth: int = 99) -> list[tuple]:
+    """(kind, start, end, node, generation) of every ray of the tree up to ``max_depth``."""
+    out = []
+    for _, node in root.flatten():
+        if node.depth > max_depth:
+            continue
+        end = node.end if node.end is not None else node.origin + miss_length * node.direction
+        kind = "blocked" if node.kind == "shadow" and node.shadow < 1.0 else node.kind
+        out.append((kind, np.asarray(node.origin), np.asarray(end), node))
+    return out
+
+
+def object_label(scene, index: int) -> str:
+    """'name (material)' of an object, as the lecture would say it."""
+    if not 0 <= index < len(scene.objects):
+        return "background"
+    obj = scene.objects[index]
+    return f"{obj.name or obj.shape} ({obj.material})"
+
+
+def draw_ray_tree(state: AppState, draw_list, origin, display_size) -> None:
+    """The picked pixel's ray tree over the ray-traced image: thick lines by kind, hit
+    points labelled with object and material."""
+    view = view_of(state)
+    scene = view.job_scene
+    from shadelab.geometry.mesh import scene_meshes
+    from shadelab.ui.overlays import scene_diagonal
+
+    miss = 0.3 * scene_diagonal(scene_meshes(scene))
+    segments = tree_segments(view.ray_tree, miss, view.tree_depth)
+    thick = 4.0 if state.presenter else 3.0
+    for kind, start, end, node in segments:
+        pts, front = project(scene, display_size, np.stack([start, end]))
+        if not front.all():
+            continue
+        a = imgui.ImVec2(origin.x + pts[0, 0], origin.y + pts[0, 1])
+        b = imgui.ImVec2(origin.x + pts[1, 0], origin.y + pts[1, 1])
+        draw_list.add_line(a, b, RAY_COLORS[kind], thick)
+        if node.end is not None and node.kind != "shadow":
+            draw_list.add_circle_filled(b, thick + 2, RAY_COLORS[kind])
+            _label(draw_list, imgui.ImVec2(b.x + 8, b.y - 8),
+                   f"{node.kind} d{node.depth}: {object_label(scene, node.object)}")
+
+
+def _screenshot_pipeline(viewer, texture) -> None:
+    """The S key in an offline pipeline: the pipeline's image as a PNG."""
+    from PIL import Image
+
+    state = viewer.state
+    path, state.screenshot_requested = state.screenshot_requested, ""
+    if texture is None:
+        state.error = f"screenshot '{path}': no image yet"
+        return
+    w, h = texture.size
+    data = np.frombuffer(texture.read(), np.uint8).reshape(h, w, 4)[::-1, :, :3]
+    try:
+        Image.fromarray(np.ascontiguousarray(data)).save(path)
+        state.status = f"screenshot {path}"
+    except (OSError, ValueError) as exc:
+        state.error = f"screenshot '{path}': cannot write ({exc})"
