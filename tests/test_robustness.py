@@ -383,3 +383,103 @@ def test_interrupt_leaves_no_partial_file(tmp_path, monkeypatch, capsys):
     assert "interrupted" in capsys.readouterr().err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["p.toml"]
     del np
+
+
+# ---------------------------------------------------------------- 2. resource limits
+
+
+def _limit_error(capsys, argv: list[str]) -> str:
+    err = one_error(capsys, argv)
+    assert ("over the limit of" in err and "--allow-large" in err) or \
+        "more than this machine has" in err, err
+    return err
+
+
+@pytest.mark.parametrize("args", [
+    ["raytrace", "--size", "16384x16384"],
+    ["raytrace", "--size", "8192x8192"],
+    ["pathtrace", "--spp", "5000000"],
+    ["raytrace", "--spp", "10000", "--size", "512x512"],
+    ["raytrace", "--set", "raytrace.spp=65536", "--size", "512x512"],
+    ["render", "--size", "16384x8192"],
+    ["radiosity", "--patches", "10000000"],
+    ["radiosity", "--set", "radiosity.patches=1000000"],
+    ["radiosity", "--patches", "50000"],
+])
+def test_work_past_the_limits_is_refused_up_front(tmp_path, capsys, args):
+    err = _limit_error(capsys, [args[0], "cornell", "-o", str(tmp_path / "x.png"), *args[1:]])
+    assert "about" in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_allow_large_lifts_a_time_limit_but_not_memory(tmp_path, capsys, monkeypatch):
+    from shadelab import limits
+
+    monkeypatch.setattr(limits, "MAX_SAMPLES", 10)
+    argv = ["raytrace", _preset(tmp_path, GOOD), "-o", str(tmp_path / "x.png"), "--size", "4x4"]
+    assert "16 samples, over the limit of 10 samples" in _limit_error(capsys, argv)
+    assert main([*argv, "--allow-large"]) == 0
+    assert (tmp_path / "x.png").is_file()
+    assert limits.ALLOW_ENV not in __import__("os").environ  # restored after the run
+    capsys.readouterr()
+    monkeypatch.setattr(limits, "physical_memory", lambda: 2**26)
+    err = _limit_error(capsys, ["radiosity", "cornell", "-o", str(tmp_path / "y.png"),
+                                "--size", "8x8", "--patches", "4000", "--allow-large"])
+    assert "--patches 4000: about 4 kpatches would need ~122 MiB of memory, more than this " \
+        "machine has (64 MiB)" in err
+
+
+@pytest.mark.parametrize("objects, expected", [
+    ('[[objects]]\nshape = "box"\n' * 10_001, "10 kobjects, over the limit of 10 kobjects"),
+    ('[[objects]]\nshape = "sphere"\nsubdivisions = 7\n' * 13,
+     "4.26 Mtriangles, over the limit of 4 Mtriangles"),
+    ('[[objects]]\nshape = "quad"\nsegments = 512\nvertices = [[0.0,0.0,0.0],[1.0,0.0,0.0],'
+     '[1.0,1.0,0.0],[0.0,1.0,0.0]]\n' * 8, "4.19 Mtriangles"),
+])
+def test_scene_size_limits(tmp_path, capsys, objects, expected):
+    text = "schema_version = 1\n[[lights]]\nposition = [0.0, 5.0, 0.0]\n" + objects
+    err = _limit_error(capsys, ["validate", _preset(tmp_path, text)])
+    assert expected in err
+
+
+def test_mesh_over_the_triangle_limit_is_refused_before_its_normals(tmp_path, capsys,
+                                                                    monkeypatch):
+    from shadelab import limits
+    from shadelab.geometry import mesh
+
+    monkeypatch.setattr(limits, "MAX_TRIANGLES", 1)
+    built = []
+    monkeypatch.setattr(mesh, "corner_normals", lambda *a: built.append(a))
+    err = _limit_error(capsys, ["validate", _mesh_preset(tmp_path, TRI, name="big.obj")])
+    assert "objects.0.path: 'big.obj': about 2 triangles, over the limit of 1 triangles" in err
+    assert built == []
+
+
+def test_ctrl_c_exits_130_and_leaves_no_file(tmp_path):
+    import signal
+    import time
+
+    light = GOOD.replace('kd = 0.5', 'kd = 0.5\nemission = [1.0, 1.0, 1.0]')
+    out = tmp_path / "x.png"
+    proc = subprocess.Popen([sys.executable, "-m", "shadelab", "pathtrace",
+                             _preset(tmp_path, light), "-o", str(out), "--npy",
+                             str(tmp_path / "x.npy"), "--size", "256x256", "--spp", "4000"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(6)  # imports, JIT, into the trace
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=30)
+    assert proc.returncode == 130, err
+    assert "shadelab: interrupted" in err and "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["p.toml"]
+
+
+def test_closed_stdout_exits_quietly():
+    out = subprocess.run(f"{sys.executable} -m shadelab presets | head -1", shell=True,
+                         capture_output=True, text=True)
+    assert out.returncode == 0 and out.stdout.count("\n") == 1
+    assert out.stderr == ""
+    proc = subprocess.Popen([sys.executable, "-m", "shadelab", "presets"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.close()  # the reader is gone before the first line
+    assert proc.wait(timeout=60) == 0
+    assert proc.stderr.read() == b""

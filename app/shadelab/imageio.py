@@ -83,6 +83,14 @@ def add_scene_arguments(parser: argparse.ArgumentParser, default_size: str = "80
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                         help="override a preset value, e.g. materials.white.kd=0.5")
     parser.add_argument("--npy", metavar="OUT.npy", help="also write float32 linear radiance")
+    add_allow_large(parser)
+
+
+def add_allow_large(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--allow-large", action="store_true",
+                        help="run work past the size and time limits (images over 16 Mpixels, "
+                             "over 268 M samples, 4 M triangles, 10,000 objects, 20,000 "
+                             "patches); memory beyond this machine's is refused even then")
 
 
 def save_outputs(args: argparse.Namespace, image: np.ndarray, exposure: float = 1.0) -> None:

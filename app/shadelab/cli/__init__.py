@@ -10,9 +10,11 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 
 from shadelab.errors import ShadeLabError
+from shadelab.limits import ALLOW_ENV
 
 # Modules that contribute subcommands, in help order.
 COMMAND_MODULES = (
@@ -50,8 +52,11 @@ def main(argv: list[str] | None = None) -> int:
     commands = set(parser._subparsers._group_actions[0].choices)  # noqa: SLF001
     if not argv or (argv[0] not in commands and argv[0] not in ("-h", "--help")):
         argv = ["view", *argv]  # 'shadelab [PRESET] [view options]' opens the viewer
+    saved_allow = os.environ.get(ALLOW_ENV)
     try:
         args = parser.parse_args(argv)
+        if getattr(args, "allow_large", False):
+            os.environ[ALLOW_ENV] = "1"  # seen by every check, and by worker processes
         return int(args.run(args) or 0)
     except ShadeLabError as exc:
         print(f"shadelab: error: {exc}", file=sys.stderr)
@@ -59,6 +64,17 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("shadelab: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # 'shadelab presets | head -1': the reader has what it wanted
+        try:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no flush error
+        except (OSError, ValueError):
+            pass
+        return 0
+    finally:
+        if saved_allow is None:
+            os.environ.pop(ALLOW_ENV, None)
+        else:
+            os.environ[ALLOW_ENV] = saved_allow
 
 
 if __name__ == "__main__":

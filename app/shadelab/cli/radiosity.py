@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from shadelab import limits
 from shadelab.imageio import add_scene_arguments, check_outputs, parse_size, save_outputs
 from shadelab.progress import run_to_end
 from shadelab.scene.model import RADIOSITY_SOLVERS as SOLVERS
@@ -35,6 +36,9 @@ def run_radiosity(args: argparse.Namespace) -> int:
 
         check_count(args.patches)
     scene = load_preset(args.preset, args.set)
+    limits.check_pixels(size, bytes_per_pixel=64)
+    limits.check_patches(args.patches or scene.radiosity.patches,
+                         "--patches" if args.patches else "radiosity.patches")
     if getattr(args, "error", None) is not None:
         from shadelab.studies.autoquality import check_budget
 

@@ -7,6 +7,7 @@ import sys
 
 import numpy as np
 
+from shadelab import limits
 from shadelab.errors import ShadeLabError
 from shadelab.imageio import add_scene_arguments, check_outputs, parse_size, save_outputs
 from shadelab.raytrace import BACKENDS
@@ -76,6 +77,10 @@ def run_raytrace(args: argparse.Namespace) -> int:
     _check_counts(args.depth, args.spp, args.workers)
     scene = load_preset(args.preset, list(args.set))
     _check_scene(scene, args.preset)
+    limits.check_pixels(size)
+    if getattr(args, "error", None) is None:
+        spp = args.spp or scene.raytrace.spp
+        limits.check_samples(size, spp, "--spp" if args.spp else "raytrace.spp")
     if not scene.active_lights():
         raise ShadeLabError(f"{args.preset}: lights: the ray tracer needs at least one "
                             "enabled light")
@@ -110,6 +115,8 @@ def run_pathtrace(args: argparse.Namespace) -> int:
     _check_seed(args.seed)
     scene = load_preset(args.preset, list(args.set))
     _check_scene(scene, args.preset)
+    limits.check_pixels(size)
+    limits.check_samples(size, args.spp)
     emitters = [o for o in scene.objects
                 if np.max(scene.materials[o.material].emission) > 0.0]
     if not emitters:

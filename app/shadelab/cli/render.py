@@ -4,8 +4,15 @@ from __future__ import annotations
 
 import argparse
 
+from shadelab import limits
 from shadelab.errors import ShadeLabError
-from shadelab.imageio import add_scene_arguments, check_outputs, parse_size, save_outputs
+from shadelab.imageio import (
+    add_allow_large,
+    add_scene_arguments,
+    check_outputs,
+    parse_size,
+    save_outputs,
+)
 from shadelab.scene.model import SHADING_MODES, SPECULAR_MODELS
 from shadelab.scene.preset import list_presets, load_preset, read_toml, resolve_preset
 
@@ -33,6 +40,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
     p = sub.add_parser("validate", help="check presets; exit 2 on the first bad one")
     p.add_argument("presets", nargs="+", metavar="PRESET")
+    add_allow_large(p)
     p.set_defaults(run=run_validate)
 
 
@@ -48,6 +56,7 @@ def run_render(args: argparse.Namespace) -> int:
         if getattr(args, flag, False):
             overrides.append(f"render.{flag}=true")
     scene = load_preset(args.preset, overrides)
+    limits.check_pixels(size, bytes_per_pixel=64)
     if getattr(args, "error", None) is not None:
         from shadelab.studies.autoquality import check_budget
 

@@ -15,6 +15,7 @@ import numpy as np
 import trimesh
 from trimesh.transformations import euler_matrix
 
+from shadelab import limits
 from shadelab.errors import ShadeLabError
 from shadelab.geometry.normals import corner_normals, face_areas, face_normals
 from shadelab.paths import file_problem
@@ -69,7 +70,16 @@ def object_mesh(obj: Object, index: int = 0, base_dir: str = ".") -> MeshData:
 
 
 def scene_meshes(scene: Scene) -> list[MeshData]:
-    return [object_mesh(obj, i, scene.base_dir) for i, obj in enumerate(scene.objects)]
+    """Every object's mesh; the scene's triangles stay within limits.MAX_TRIANGLES (one file
+    over it is refused by load_mesh_file before its normals are built)."""
+    meshes = []
+    total = 0
+    for i, obj in enumerate(scene.objects):
+        meshes.append(object_mesh(obj, i, scene.base_dir))
+        total += len(meshes[-1].faces)
+        limits.check(f"objects: the scene's first {i + 1} meshes", total, limits.MAX_TRIANGLES,
+                     "triangles")
+    return meshes
 
 
 def scene_bounds(meshes: list[MeshData]) -> np.ndarray:
@@ -200,6 +210,9 @@ def load_mesh_file(path: str, base_dir: str, key: str) -> trimesh.Trimesh:
     if full.suffix.lower() not in MESH_SUFFIXES:
         raise ShadeLabError(f"{key}: '{full.name}' is not a mesh file "
                             f"(expected one of {', '.join(MESH_SUFFIXES)})")
+    size = full.stat().st_size
+    limits.check(f"{key}: '{full.name}'", size, limits.MAX_MESH_FILE_BYTES, "bytes",
+                 memory_bytes=8.0 * size)  # trimesh's arrays and its text parse
     try:
         mesh = trimesh.load(str(full), force="mesh", process=False)
     except Exception as exc:  # trimesh raises many types for corrupt files
@@ -207,6 +220,8 @@ def load_mesh_file(path: str, base_dir: str, key: str) -> trimesh.Trimesh:
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         raise ShadeLabError(f"{key}: '{full.name}' holds no triangles (empty mesh)")
     check_vertices(np.asarray(mesh.vertices, dtype=np.float64), f"{key}: '{full.name}'")
+    limits.check(f"{key}: '{full.name}'", len(mesh.faces), limits.MAX_TRIANGLES, "triangles",
+                 memory_bytes=400.0 * len(mesh.faces))  # normals, BVH, GL buffers
     areas = face_areas(np.asarray(mesh.vertices, float), np.asarray(mesh.faces))
     degenerate = np.flatnonzero(areas <= 1e-12 * max(float(areas.max()), 1e-300))
     if len(degenerate):

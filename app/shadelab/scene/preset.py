@@ -17,6 +17,7 @@ from typing import Any
 
 import tomli_w
 
+from shadelab import limits
 from shadelab.errors import ShadeLabError
 from shadelab.paths import OutputSet, file_problem, output_problem, resolve_link
 from shadelab.resources import presets_dir
@@ -294,8 +295,21 @@ def _check(cls: type, key: str, value: Any, source: str, where: str) -> Any:
     raise AssertionError(kind)
 
 
+def estimated_triangles(obj: Object) -> int:
+    """Triangles a primitive will have (closed form, before meshing); 0 for mesh files,
+    whose count is checked when they are read."""
+    sec = obj.sections
+    return {"sphere": 20 * 4 ** obj.subdivisions, "box": 12, "cylinder": 4 * sec,
+            "cone": 2 * sec, "capsule": 2 * sec * sec, "torus": 2 * sec * max(sec // 2, 3),
+            "plane": 2 * obj.segments ** 2, "quad": 2 * obj.segments ** 2}.get(obj.shape, 0)
+
+
 def _cross_check(scene: Scene, source: str) -> None:
     """Checks that span tables: material references, required shape keys, light count."""
+    limits.check(f"{source}: key 'objects'", len(scene.objects), limits.MAX_OBJECTS, "objects")
+    limits.check(f"{source}: key 'objects' (primitives)",
+                 sum(estimated_triangles(obj) for obj in scene.objects), limits.MAX_TRIANGLES,
+                 "triangles")
     if len(scene.lights) > MAX_LIGHTS:
         raise ShadeLabError(f"{source}: key 'lights': at most {MAX_LIGHTS} lights, "
                             f"got {len(scene.lights)}")
