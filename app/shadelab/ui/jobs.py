@@ -257,18 +257,19 @@ def iter_reference_raster(scene: Scene, size: tuple[int, int], rows_per_chunk: i
     """
     from shadelab.geometry.mesh import scene_meshes
     from shadelab.shading.reference import normalize, shade
-    from shadelab.ui.probe import _facing, intersect_many
+    from shadelab.ui.probe import Picker, _facing
 
     scene = clone_scene(scene)
     width, height = size
     meshes = scene_meshes(scene)
+    picker = Picker(scene, meshes)
     origins, directions = primary_rays(scene.camera, width, height)
     image = np.zeros((height, width, 3), np.float32)
     eye = np.asarray(scene.camera.eye, dtype=np.float64)
     for y0 in range(0, height, rows_per_chunk):
         o = origins[y0:y0 + rows_per_chunk].reshape(-1, 3)
         d = directions[y0:y0 + rows_per_chunk].reshape(-1, 3)
-        mesh_id, face, t, bary = intersect_many(meshes, o, d)
+        mesh_id, face, t, bary = picker.hits(o, d)
         out = np.zeros((len(o), 3))
         for m, mesh in enumerate(meshes):
             sel = np.flatnonzero(mesh_id == m)

@@ -1,7 +1,9 @@
 """The pixel probe: which surface point a viewport pixel shows, and the lecture's terms there.
 
 Pure numpy (no GL): a ray through the pixel centre (``primary_rays``, aligned with the raster
-image) is cast against the scene's MeshData triangles; the reference equation
+image) is cast against the scene's MeshData triangles with the ray tracer's acceleration
+structure (Embree, or the numba BVH without it: :mod:`shadelab.raytrace.accel`); the reference
+equation
 (:func:`shadelab.shading.reference.shade_terms`) is evaluated the way the chosen shading mode does:
 
 - flat: once per triangle at its centroid, with the face normal;
@@ -18,11 +20,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from shadelab.geometry.mesh import MeshData, scene_meshes
+from shadelab.raytrace.accel import build_accel, scene_geometry
 from shadelab.scene.camera import primary_rays
 from shadelab.scene.model import Scene
 from shadelab.shading.reference import ShadeTerms, halfway, normalize, reflect_light, shade_terms
-
-_EPS = 1e-12
 
 
 @dataclass
@@ -62,29 +63,37 @@ class ProbeResult:
         return reflect_light(self.normal, to_light)
 
 
-def intersect(meshes: list[MeshData], origin: np.ndarray, direction: np.ndarray) -> Hit | None:
-    """Nearest hit of one ray against every triangle (Moller-Trumbore, vectorized)."""
-    best: Hit | None = None
-    for mesh in meshes:
-        tri = mesh.triangles
-        e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
-        p = np.cross(direction, e2)
-        det = np.einsum("ij,ij->i", e1, p)
-        ok = np.abs(det) > _EPS
-        inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
-        s = origin - tri[:, 0]
-        u = np.einsum("ij,ij->i", s, p) * inv
-        q = np.cross(s, e1)
-        v = (q @ direction) * inv
-        t = np.einsum("ij,ij->i", e2, q) * inv
-        valid = ok & (u >= -1e-9) & (v >= -1e-9) & (u + v <= 1 + 1e-9) & (t > 1e-9)
-        if not valid.any():
-            continue
-        face = int(np.flatnonzero(valid)[np.argmin(t[valid])])
-        if best is None or t[face] < best.t:
-            bary = np.array([1.0 - u[face] - v[face], u[face], v[face]])
-            best = Hit(mesh, face, float(t[face]), origin + t[face] * direction, bary)
-    return best
+class Picker:
+    """The scene's triangles in the ray tracer's accelerator, answering in MeshData terms."""
+
+    def __init__(self, scene: Scene, meshes: list[MeshData]):
+        self.meshes = meshes
+        self.accel = build_accel(scene_geometry(scene, meshes))
+        self.starts = np.cumsum([0] + [len(m.faces) for m in meshes])  # first triangle of each
+
+    def hits(self, origins: np.ndarray, directions: np.ndarray):
+        """Nearest hits of (R, 3) rays: mesh index (-1 = miss), face, t, barycentrics (R, 3)."""
+        hits = self.accel.intersect(origins, directions)
+        hit = hits.tri >= 0
+        mesh_id = np.where(hit, np.searchsorted(self.starts, hits.tri, side="right") - 1, -1)
+        face = np.where(hit, hits.tri - self.starts[np.maximum(mesh_id, 0)], 0)
+        bary = np.stack([1.0 - hits.u - hits.v, hits.u, hits.v], axis=1)
+        return mesh_id, face, hits.t, np.where(hit[:, None], bary, 0.0)
+
+
+def intersect_many(scene: Scene, meshes: list[MeshData], origins: np.ndarray,
+                   directions: np.ndarray):
+    """Nearest hits of (R, 3) rays (see :meth:`Picker.hits`)."""
+    return Picker(scene, meshes).hits(origins, directions)
+
+
+def intersect(scene: Scene, meshes: list[MeshData], origin: np.ndarray,
+              direction: np.ndarray) -> Hit | None:
+    """Nearest hit of one ray against every triangle of ``meshes``."""
+    mesh_id, face, t, bary = intersect_many(scene, meshes, origin[None], direction[None])
+    if mesh_id[0] < 0:
+        return None
+    return Hit(meshes[mesh_id[0]], int(face[0]), float(t[0]), origin + t[0] * direction, bary[0])
 
 
 def cast_pixel(scene: Scene, size: tuple[int, int], pixel: tuple[int, int],
@@ -94,7 +103,7 @@ def cast_pixel(scene: Scene, size: tuple[int, int], pixel: tuple[int, int],
     x, y = pixel
     origins, directions = primary_rays(scene.camera, width, height)
     meshes = scene_meshes(scene) if meshes is None else meshes
-    return intersect(meshes, origins[y, x], directions[y, x])
+    return intersect(scene, meshes, origins[y, x], directions[y, x])
 
 
 def _facing(n: np.ndarray, face_normal: np.ndarray, to_eye: np.ndarray) -> np.ndarray:
@@ -136,40 +145,3 @@ def probe(scene: Scene, size: tuple[int, int], pixel: tuple[int, int], shading: 
     return ProbeResult(pixel, hit, shading, specular, normal, to_eye, terms,
                        np.asarray(reference, dtype=np.float64))
 
-
-def intersect_many(meshes: list[MeshData], origins: np.ndarray, directions: np.ndarray,
-                   budget: int = 2_000_000):
-    """Nearest hits of (R, 3) rays: mesh index (-1 = miss), face, t, barycentrics (R, 3)."""
-    count = len(origins)
-    best_t = np.full(count, np.inf)
-    mesh_id = np.full(count, -1)
-    face_id = np.zeros(count, np.int64)
-    bary = np.zeros((count, 3))
-    for m, mesh in enumerate(meshes):
-        tri = mesh.triangles
-        e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
-        step = max(1, budget // max(len(tri), 1))
-        for r0 in range(0, count, step):
-            o, d = origins[r0:r0 + step, None, :], directions[r0:r0 + step, None, :]
-            p = np.cross(d, e2[None])
-            det = np.sum(e1[None] * p, axis=-1)
-            ok = np.abs(det) > _EPS
-            inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
-            s = o - tri[None, :, 0]
-            u = np.sum(s * p, axis=-1) * inv
-            q = np.cross(s, e1[None])
-            v = np.sum(q * d, axis=-1) * inv
-            t = np.sum(e2[None] * q, axis=-1) * inv
-            valid = ok & (u >= -1e-9) & (v >= -1e-9) & (u + v <= 1 + 1e-9) & (t > 1e-9)
-            t = np.where(valid, t, np.inf)
-            f = np.argmin(t, axis=1)
-            rows = np.arange(len(f))
-            tf = t[rows, f]
-            closer = tf < best_t[r0:r0 + step]
-            idx = np.flatnonzero(closer) + r0
-            best_t[idx] = tf[closer]
-            mesh_id[idx] = m
-            face_id[idx] = f[closer]
-            uf, vf = u[rows, f][closer], v[rows, f][closer]
-            bary[idx] = np.stack([1.0 - uf - vf, uf, vf], axis=1)
-    return mesh_id, face_id, best_t, bary
