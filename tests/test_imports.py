@@ -48,10 +48,11 @@ def internal_graph() -> dict[str, set[str]]:
     graph: dict[str, set[str]] = {name: set() for name in known}
     for name, path in known.items():
         for base, names, _ in imported(name, path):
-            # ``from pkg import mod`` imports the submodule pkg.mod where one exists
-            for target in [base, *(f"{base}.{n}" for n in names)]:
-                if target in known and target != name:
-                    graph[name].add(target)
+            # ``from pkg import mod`` imports the submodule pkg.mod where one exists; pkg
+            # itself counts only for names that are not submodules (attributes of pkg)
+            subs = [f"{base}.{n}" for n in names if f"{base}.{n}" in known]
+            targets = subs if names and len(subs) == len(names) else [base, *subs]
+            graph[name].update(t for t in targets if t in known and t != name)
     return graph
 
 

@@ -6,7 +6,11 @@
 //   I = Le + Ia ka Od + sum_i S_i f_att,i Ip,i [kd Od (N.L_i) + ks Os (R_i.V)^n]
 //   f_att = 1 | 1/d^2 | min(1/(c1 + c2 d + c3 d^2), 1);   R = 2N(N.L) - L;   H = (L+V)/|L+V|
 
-#define MAX_LIGHTS 16
+// Generated ahead of this text by the program loader (shadelab/gl/programs.py) from the Python
+// table (shadelab/shading/codes.py, shadelab/constants.py): MAX_LIGHTS, SHADING_EPS, the light
+// kinds LIGHT_POINT | LIGHT_DIRECTIONAL | LIGHT_SPOT, the attenuation modes ATTENUATION_NONE |
+// ATTENUATION_INVERSE_SQUARE | ATTENUATION_LECTURE and SPECULAR_PHONG | SPECULAR_BLINN.
+//
 // The renderer compiles one variant per light configuration: NUM_LIGHTS, LIGHT_KINDS and
 // LIGHT_ATTENUATIONS (2 bits per light, light i at bits 2i..2i+1, as uint literals) and
 // SPECULAR_MODEL. The loop then unrolls and every branch on a light's kind or attenuation folds
@@ -24,23 +28,20 @@
 #ifndef SPECULAR_MODEL
 #define SPECULAR_MODEL u_specular_model
 #endif
-#define LIGHT_POINT 0
-#define LIGHT_DIRECTIONAL 1
-#define LIGHT_SPOT 2
 
 uniform int u_num_lights;                        // lights in use, <= MAX_LIGHTS
 uniform int u_light_kind[MAX_LIGHTS];            // LIGHT_POINT | LIGHT_DIRECTIONAL | LIGHT_SPOT
 uniform vec3 u_light_position[MAX_LIGHTS];       // world space (point, spot)
 uniform vec3 u_light_direction[MAX_LIGHTS];      // unit, the way the light travels
 uniform vec3 u_light_Ip[MAX_LIGHTS];             // RGB intensity
-uniform int u_light_attenuation[MAX_LIGHTS];     // 0 none, 1 inverse square, 2 lecture
+uniform int u_light_attenuation[MAX_LIGHTS];     // ATTENUATION_NONE | _INVERSE_SQUARE | _LECTURE
 uniform vec3 u_light_c[MAX_LIGHTS];              // c1, c2, c3 of the lecture's f_att
 uniform vec2 u_light_spot[MAX_LIGHTS];           // cos(cone half-angle), falloff exponent
 uniform float u_light_S[MAX_LIGHTS];             // shadow factor S_i: 1 lit, 0 blocked
 
 uniform vec3 u_Ia;                               // ambient intensity
 uniform float u_ambient_on;                      // 1: add Le + Ia ka Od (first pass only)
-uniform int u_specular_model;                    // 0 Phong (R.V)^n, 1 Blinn-Phong (N.H)^n
+uniform int u_specular_model;                    // SPECULAR_PHONG (R.V)^n | SPECULAR_BLINN (N.H)^n
 
 uniform float u_ka;
 uniform float u_kd;
@@ -49,8 +50,6 @@ uniform float u_n;
 uniform vec3 u_Od;
 uniform vec3 u_Os;
 uniform vec3 u_emission;
-
-const float SHADING_EPS = 1e-12;
 
 float lambert(vec3 n, vec3 to_light) {
     return max(dot(n, to_light), 0.0);
@@ -85,7 +84,8 @@ float attenuation(float distance, int mode, vec3 c) {
     float inverse_square = 1.0 / max(distance * distance, SHADING_EPS);
     float lecture = min(1.0 / max(c.x + c.y * distance + c.z * distance * distance,
                                   SHADING_EPS), 1.0);
-    return mode == 1 ? inverse_square : (mode == 2 ? lecture : 1.0);
+    return mode == ATTENUATION_INVERSE_SQUARE ? inverse_square
+         : (mode == ATTENUATION_LECTURE ? lecture : 1.0);
 }
 
 float spot_factor(vec3 to_light, vec3 axis, float cos_cone, float exponent) {
@@ -107,7 +107,7 @@ vec3 shade_light(int i, vec3 position, vec3 n, vec3 to_eye, vec3 od) {
     if (kind == LIGHT_SPOT)
         spot = spot_factor(to_light, u_light_direction[i], u_light_spot[i].x, u_light_spot[i].y);
     float specular;
-    if (SPECULAR_MODEL == 1) specular = blinn_phong_specular(n, to_light, to_eye, u_n);
+    if (SPECULAR_MODEL == SPECULAR_BLINN) specular = blinn_phong_specular(n, to_light, to_eye, u_n);
     else specular = phong_specular(n, to_light, to_eye, u_n);
     vec3 scale = u_light_S[i] * f_att * spot * u_light_Ip[i];
     return scale * (u_kd * od * lambert(n, to_light) + u_ks * u_Os * specular);

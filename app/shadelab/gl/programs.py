@@ -1,6 +1,9 @@
 """Load GLSL programs from ``shaders/``: one file per stage, chunks from ``shaders/include``.
 
-Chunks are registered as moderngl named includes (``#include "lighting"``).
+Chunks are registered as moderngl named includes (``#include "lighting"``). The lighting
+chunk starts with ``#define``s generated from the Python table of codes and constants
+(:func:`shadelab.shading.codes.glsl_header`: ``LIGHT_SPOT``, ``ATTENUATION_LECTURE``,
+``SHADING_EPS`` ...), so the GLSL holds no hand-written copy of them.
 """
 
 from __future__ import annotations
@@ -8,11 +11,17 @@ from __future__ import annotations
 import moderngl
 
 from shadelab.resources import shaders_dir
+from shadelab.shading import codes, conventions
+
+# Generated text put at the head of an include (moderngl includes do not nest)
+GENERATED_HEADERS = {"lighting": codes.glsl_header, "color": conventions.glsl_header}
 
 
 def register_includes(ctx: moderngl.Context) -> None:
     for path in sorted((shaders_dir() / "include").glob("*.glsl")):
-        ctx.includes[path.stem] = path.read_text(encoding="utf-8")
+        header = GENERATED_HEADERS.get(path.stem)
+        text = path.read_text(encoding="utf-8")
+        ctx.includes[path.stem] = (header() if header else "") + text
 
 
 def with_defines(source: str, defines: dict[str, object] | None) -> str:

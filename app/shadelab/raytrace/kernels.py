@@ -15,11 +15,16 @@ import math
 import numba as nb
 import numpy as np
 
+from shadelab.constants import SHADING_EPS as EPS
 from shadelab.scene.model import Light, Material
-from shadelab.shading.reference import ATTENUATION_CODES
+from shadelab.shading.codes import ATTENUATION_CODES, LIGHT_KIND_CODES
+from shadelab.shading.lights import pack_lights
 
-EPS = 1e-12
-LIGHT_KIND_CODES = {"point": 0, "directional": 1, "spot": 2}
+# The codes as the light table stores them (float64); numba freezes them at compile time
+_DIRECTIONAL = float(LIGHT_KIND_CODES["directional"])
+_SPOT = float(LIGHT_KIND_CODES["spot"])
+_ATT_NONE = float(ATTENUATION_CODES["none"])
+_ATT_INVERSE_SQUARE = float(ATTENUATION_CODES["inverse_square"])
 
 # Material table columns
 M_KA, M_KD, M_KS, M_N, M_OD, M_OS, M_LE = 0, 1, 2, 3, 4, 7, 10
@@ -42,26 +47,25 @@ def material_table(materials: list[Material]) -> np.ndarray:
 
 
 def light_table(lights: list[Light]) -> np.ndarray:
-    """(L, 16) float64: kind, position, unit direction, Ip, attenuation, c1-c3, cos cone, e."""
+    """(L, 16) float64: kind, position, unit direction, Ip, attenuation, c1-c3, cos cone, e
+    (from :func:`shadelab.shading.lights.pack_lights`, as the GL uniforms are)."""
+    packed = pack_lights(lights)
     table = np.zeros((len(lights), LIGHT_COLUMNS))
-    for i, light in enumerate(lights):
-        direction = np.asarray(light.direction, dtype=np.float64)
-        length = np.linalg.norm(direction)
-        table[i, L_KIND] = LIGHT_KIND_CODES[light.kind]
-        table[i, L_POS:L_POS + 3] = light.position
-        table[i, L_DIR:L_DIR + 3] = direction / length if length > EPS else 0.0
-        table[i, L_IP:L_IP + 3] = light.Ip
-        table[i, L_ATT] = ATTENUATION_CODES[light.attenuation]
-        table[i, L_C1:L_C3 + 1] = (light.c1, light.c2, light.c3)
-        table[i, L_COS] = math.cos(math.radians(light.cone_angle))
-        table[i, L_EXP] = light.spot_exponent
+    table[:, L_KIND] = packed.kind
+    table[:, L_POS:L_POS + 3] = packed.position
+    table[:, L_DIR:L_DIR + 3] = packed.direction
+    table[:, L_IP:L_IP + 3] = packed.Ip
+    table[:, L_ATT] = packed.attenuation
+    table[:, L_C1:L_C3 + 1] = packed.c
+    table[:, L_COS] = packed.spot[:, 0]
+    table[:, L_EXP] = packed.spot[:, 1]
     return table
 
 
 @nb.njit(cache=True, inline="always")
 def _to_light(lights, k, px, py, pz):
     """Unit vector to light k and its distance (inf for a directional light)."""
-    if lights[k, L_KIND] == 1.0:
+    if lights[k, L_KIND] == _DIRECTIONAL:
         dx, dy, dz = -lights[k, L_DIR], -lights[k, L_DIR + 1], -lights[k, L_DIR + 2]
         length = math.sqrt(dx * dx + dy * dy + dz * dz)
         if length > EPS:
@@ -103,16 +107,16 @@ def local_shade(position, normal, to_eye, mat, mats, lights, ia, blinn, shadow):
             lx, ly, lz, dist = _to_light(lights, k, px, py, pz)
             # f_att
             att = lights[k, L_ATT]
-            if not math.isfinite(dist) or att == 0.0:
+            if not math.isfinite(dist) or att == _ATT_NONE:
                 f_att = 1.0
-            elif att == 1.0:
+            elif att == _ATT_INVERSE_SQUARE:
                 f_att = 1.0 / max(dist * dist, EPS)
             else:
                 den = lights[k, L_C1] + lights[k, L_C2] * dist + lights[k, L_C3] * dist * dist
                 f_att = min(1.0 / max(den, EPS), 1.0)
             # spot cone
             spot = 1.0
-            if lights[k, L_KIND] == 2.0:
+            if lights[k, L_KIND] == _SPOT:
                 cos_phi = -(lx * lights[k, L_DIR] + ly * lights[k, L_DIR + 1]
                             + lz * lights[k, L_DIR + 2])
                 if cos_phi >= lights[k, L_COS]:
@@ -186,6 +190,77 @@ def shadow_rays(position, geo, lights, k, eps, t_inf):
     return origins, dirs, tmax, facing
 
 
+# ---------------------------------------------------------------------- scattering helpers
+# pbrt-v4's names: Reflect, FrDielectric, Refract, SampleCosineHemisphere. Inlined, so the
+# callers compile to what they were when these lines were written out in each of them.
+@nb.njit(cache=True, inline="always")
+def _ior_pair(entering, ior):
+    """(n1, n2): from air into the medium when entering, out of it otherwise."""
+    if entering:
+        return 1.0, ior
+    return ior, 1.0
+
+
+@nb.njit(cache=True, inline="always")
+def _reflect(dx, dy, dz, nx, ny, nz, cos_i):
+    """Unit mirror direction of the incident ray d about n (cos_i = -d.n, clamped)."""
+    rx, ry, rz = dx + 2.0 * cos_i * nx, dy + 2.0 * cos_i * ny, dz + 2.0 * cos_i * nz
+    length = math.sqrt(rx * rx + ry * ry + rz * rz)
+    return rx / length, ry / length, rz / length
+
+
+@nb.njit(cache=True, inline="always")
+def _fr_dielectric(cos_i, n1, n2):
+    """Fresnel reflectance F of unpolarized light (1 under total internal reflection), the
+    cosine of the refracted ray (0 under TIR) and whether TIR happens."""
+    eta = n1 / n2
+    k = 1.0 - eta * eta * (1.0 - cos_i * cos_i)
+    tir = k < 0.0
+    cos_t = math.sqrt(max(k, 0.0))
+    if tir:
+        return 1.0, cos_t, tir
+    rs = (n1 * cos_i - n2 * cos_t) / max(n1 * cos_i + n2 * cos_t, 1e-300)
+    rp = (n2 * cos_i - n1 * cos_t) / max(n2 * cos_i + n1 * cos_t, 1e-300)
+    return 0.5 * (rs * rs + rp * rp), cos_t, tir
+
+
+@nb.njit(cache=True, inline="always")
+def _refract(dx, dy, dz, nx, ny, nz, eta, cos_i, cos_t):
+    """Unit refracted direction (Snell: eta = n1 / n2) of the incident ray d through n."""
+    a = eta * cos_i - cos_t
+    tx, ty, tz = eta * dx + a * nx, eta * dy + a * ny, eta * dz + a * nz
+    length = math.sqrt(tx * tx + ty * ty + tz * tz)
+    return tx / length, ty / length, tz / length
+
+
+@nb.njit(cache=True, inline="always")
+def _sample_cosine_hemisphere(u1, u2, nx, ny, nz):
+    """A cosine-weighted direction about the unit n (Malley: a disk point lifted) and its
+    cosine with n (pdf = cos / pi). The frame is Duff et al.'s branchless ONB."""
+    r = math.sqrt(u1)
+    phi = 2.0 * math.pi * u2
+    lx, ly, lz = r * math.cos(phi), r * math.sin(phi), math.sqrt(max(1.0 - u1, 0.0))
+    sign = 1.0 if nz >= 0.0 else -1.0
+    aa = -1.0 / (sign + nz)
+    bb = nx * ny * aa
+    tx, ty, tz = 1.0 + sign * nx * nx * aa, sign * bb, -sign * nx
+    bx, by, bz = bb, sign + ny * ny * aa, -ny
+    ox = lx * tx + ly * bx + lz * nx
+    oy = lx * ty + ly * by + lz * ny
+    oz = lx * tz + ly * bz + lz * nz
+    return ox, oy, oz, lz
+
+
+@nb.njit(cache=True, inline="always")
+def _store_ray(out_o, out_d, out_w, out_p, count, position, geo, i, side, eps, d, w, pixel):
+    """Row ``count`` of the next generation: origin off the surface on ``side``, d, w, pixel."""
+    out_d[count, 0], out_d[count, 1], out_d[count, 2] = d
+    for c in range(3):
+        out_o[count, c] = position[i, c] + side * eps * geo[i, c]
+    out_w[count, 0], out_w[count, 1], out_w[count, 2] = w
+    out_p[count] = pixel
+
+
 @nb.njit(cache=True)
 def spawn_secondary(position, normal, geo, entering, dirs, mat, weight, pixel, kr, kt, ior,
                     tint, fresnel, min_weight, eps):
@@ -208,20 +283,8 @@ def spawn_secondary(position, normal, geo, entering, dirs, mat, weight, pixel, k
         dx, dy, dz = dirs[i, 0], dirs[i, 1], dirs[i, 2]
         nx, ny, nz = normal[i, 0], normal[i, 1], normal[i, 2]
         cos_i = min(max(-(dx * nx + dy * ny + dz * nz), 0.0), 1.0)
-        if entering[i]:
-            n1, n2 = 1.0, ior[m]
-        else:
-            n1, n2 = ior[m], 1.0
-        eta = n1 / n2
-        k = 1.0 - eta * eta * (1.0 - cos_i * cos_i)
-        tir = k < 0.0
-        cos_t = math.sqrt(max(k, 0.0))
-        if tir:
-            f = 1.0
-        else:
-            rs = (n1 * cos_i - n2 * cos_t) / max(n1 * cos_i + n2 * cos_t, 1e-300)
-            rp = (n2 * cos_i - n1 * cos_t) / max(n2 * cos_i + n1 * cos_t, 1e-300)
-            f = 0.5 * (rs * rs + rp * rp)
+        n1, n2 = _ior_pair(entering[i], ior[m])
+        f, cos_t, tir = _fr_dielectric(cos_i, n1, n2)
         if fresnel:
             refl_s = kr[m] + kt[m] * f
             refr_s = kt[m] * (1.0 - f)
@@ -229,31 +292,17 @@ def spawn_secondary(position, normal, geo, entering, dirs, mat, weight, pixel, k
             refl_s = kr[m] + (kt[m] if tir else 0.0)
             refr_s = 0.0 if tir else kt[m]
         # Reflected ray
-        wr0, wr1, wr2 = weight[i, 0] * refl_s, weight[i, 1] * refl_s, weight[i, 2] * refl_s
-        if max(wr0, max(wr1, wr2)) >= threshold:
-            rx, ry, rz = dx + 2.0 * cos_i * nx, dy + 2.0 * cos_i * ny, dz + 2.0 * cos_i * nz
-            length = math.sqrt(rx * rx + ry * ry + rz * rz)
-            out_d[count, 0], out_d[count, 1], out_d[count, 2] = (rx / length, ry / length,
-                                                                 rz / length)
-            for c in range(3):
-                out_o[count, c] = position[i, c] + eps * geo[i, c]
-            out_w[count, 0], out_w[count, 1], out_w[count, 2] = wr0, wr1, wr2
-            out_p[count] = pixel[i]
+        wr = (weight[i, 0] * refl_s, weight[i, 1] * refl_s, weight[i, 2] * refl_s)
+        if max(wr[0], max(wr[1], wr[2])) >= threshold:
+            _store_ray(out_o, out_d, out_w, out_p, count, position, geo, i, 1.0, eps,
+                       _reflect(dx, dy, dz, nx, ny, nz, cos_i), wr, pixel[i])
             count += 1
         # Refracted ray
-        wt0 = weight[i, 0] * refr_s * tint[m, 0]
-        wt1 = weight[i, 1] * refr_s * tint[m, 1]
-        wt2 = weight[i, 2] * refr_s * tint[m, 2]
-        if max(wt0, max(wt1, wt2)) >= threshold:
-            a = eta * cos_i - cos_t
-            tx, ty, tz = eta * dx + a * nx, eta * dy + a * ny, eta * dz + a * nz
-            length = math.sqrt(tx * tx + ty * ty + tz * tz)
-            out_d[count, 0], out_d[count, 1], out_d[count, 2] = (tx / length, ty / length,
-                                                                 tz / length)
-            for c in range(3):
-                out_o[count, c] = position[i, c] - eps * geo[i, c]
-            out_w[count, 0], out_w[count, 1], out_w[count, 2] = wt0, wt1, wt2
-            out_p[count] = pixel[i]
+        wt = (weight[i, 0] * refr_s * tint[m, 0], weight[i, 1] * refr_s * tint[m, 1],
+              weight[i, 2] * refr_s * tint[m, 2])
+        if max(wt[0], max(wt[1], wt[2])) >= threshold:
+            _store_ray(out_o, out_d, out_w, out_p, count, position, geo, i, -1.0, eps,
+                       _refract(dx, dy, dz, nx, ny, nz, n1 / n2, cos_i, cos_t), wt, pixel[i])
             count += 1
     return out_o[:count], out_d[:count], out_w[:count], out_p[:count]
 
@@ -267,17 +316,79 @@ def add_rows(out, pixel, value, mask):
                 out[pixel[i], c] += value[i, c]
 
 
+# ---------------------------------------------------------------------- one path vertex
+@nb.njit(cache=True, inline="always")
+def _emission_weight(bsdf_pdf, t, cos_y, em_area):
+    """MIS weight (balance heuristic) of emission reached by a BSDF sample, against area
+    sampling of the emitters; 1 after a specular bounce (pdf 0)."""
+    if not bsdf_pdf > 0.0:
+        return 1.0
+    light_pdf = t * t / max(cos_y * em_area, 1e-300)
+    return bsdf_pdf / (bsdf_pdf + light_pdf)
+
+
+@nb.njit(cache=True)
+def _next_event(i, m, emitters, rho, beta, px, py, pz, nx, ny, nz, gx, gy, gz, prob_d, eps,
+                rnd, nee_o, nee_d, nee_t, nee_ok, nee_val):
+    """Next-event estimation: a shadow ray to one point on the emitters, chosen by area."""
+    em_cdf, em_p0, em_e1, em_e2, em_normal, em_le, em_area = emitters
+    k = np.searchsorted(em_cdf, rnd[i, 0], side="right")
+    k = min(k, len(em_cdf) - 1)
+    s = math.sqrt(rnd[i, 1])
+    a, b = s * (1.0 - rnd[i, 2]), s * rnd[i, 2]
+    qx = em_p0[k, 0] + a * em_e1[k, 0] + b * em_e2[k, 0] - px
+    qy = em_p0[k, 1] + a * em_e1[k, 1] + b * em_e2[k, 1] - py
+    qz = em_p0[k, 2] + a * em_e1[k, 2] + b * em_e2[k, 2] - pz
+    dist = math.sqrt(qx * qx + qy * qy + qz * qz)
+    if not dist > 2.0 * eps:
+        return
+    wx, wy, wz = qx / dist, qy / dist, qz / dist
+    cos_x = nx * wx + ny * wy + nz * wz
+    cos_y = abs(em_normal[k, 0] * wx + em_normal[k, 1] * wy + em_normal[k, 2] * wz)
+    if not (cos_x > 0.0 and gx * wx + gy * wy + gz * wz > 0.0):
+        return
+    light_pdf = dist * dist / max(cos_y * em_area, 1e-300)
+    scale = cos_x / (light_pdf + prob_d * cos_x / math.pi) / math.pi
+    nee_ok[i] = True
+    nee_o[i, 0] = px + eps * gx
+    nee_o[i, 1] = py + eps * gy
+    nee_o[i, 2] = pz + eps * gz
+    nee_d[i, 0], nee_d[i, 1], nee_d[i, 2] = wx, wy, wz
+    nee_t[i] = dist * (1.0 - 1e-4) - 2.0 * eps
+    for c in range(3):
+        nee_val[i, c] = beta[i, c] * rho[m, c] * em_le[k, c] * scale
+
+
+@nb.njit(cache=True, inline="always")
+def _specular_lobe(u, p_d, kr, kt, ior, entering, total, dx, dy, dz, nx, ny, nz, u_fresnel):
+    """Mirror or glass (Fresnel picks reflection or refraction): direction, side of the
+    surface the new ray leaves from (1 front, -1 through), weight and lobe probability."""
+    cos_i = min(max(-(dx * nx + dy * ny + dz * nz), 0.0), 1.0)
+    ox, oy, oz = _reflect(dx, dy, dz, nx, ny, nz, cos_i)
+    if u < p_d + kr:  # mirror
+        return ox, oy, oz, 1.0, kr, kr / total
+    n1, n2 = _ior_pair(entering, ior)
+    f, cos_t, _ = _fr_dielectric(cos_i, n1, n2)
+    if u_fresnel >= f:
+        ox, oy, oz = _refract(dx, dy, dz, nx, ny, nz, n1 / n2, cos_i, cos_t)
+        return ox, oy, oz, -1.0, kt, kt / total
+    return ox, oy, oz, 1.0, kt, kt / total
+
+
 @nb.njit(cache=True)
 def path_vertex(out, pixel, beta, bsdf_pdf, position, normal, geo, entering, dirs, t, mat,
-                rho, kr, kt, ior, emission, em_cdf, em_p0, em_e1, em_e2, em_normal, em_le,
-                em_area, eps, rnd, roulette):
+                surfaces, emitters, eps, rnd, roulette):
     """One path vertex per path: emission (MIS-weighted), next-event set-up, lobe choice.
 
-    Mirrors ``PathTracer`` (see :mod:`shadelab.raytrace.pathtrace` for the estimator). ``rnd``
-    holds 7 uniforms per path: emitter, 2 barycentrics, lobe, 2 direction, roulette.
+    Mirrors ``PathTracer`` (see :mod:`shadelab.raytrace.pathtrace` for the estimator).
+    ``surfaces`` = (rho, kr, kt, ior, emission) per material; ``emitters`` = (cdf, p0, e1, e2,
+    normal, le, total area) of the emitting triangles. ``rnd`` holds 7 uniforms per path:
+    emitter, 2 barycentrics, lobe, 2 direction, roulette.
     Returns the shadow rays of next-event estimation (origins, dirs, tmax, candidate flag,
     unoccluded contribution) and the continued paths (origins, dirs, beta, pdf, alive).
     """
+    rho, kr, kt, ior, emission = surfaces
+    em_area = emitters[6]
     n = len(pixel)
     nee_o = np.empty((n, 3))
     nee_d = np.empty((n, 3))
@@ -289,7 +400,7 @@ def path_vertex(out, pixel, beta, bsdf_pdf, position, normal, geo, entering, dir
     new_beta = np.empty((n, 3))
     new_pdf = np.zeros(n)
     alive = np.zeros(n, np.bool_)
-    n_em = len(em_cdf)
+    n_em = len(emitters[0])
     for i in range(n):
         m = mat[i]
         px, py, pz = position[i, 0], position[i, 1], position[i, 2]
@@ -297,13 +408,8 @@ def path_vertex(out, pixel, beta, bsdf_pdf, position, normal, geo, entering, dir
         gx, gy, gz = geo[i, 0], geo[i, 1], geo[i, 2]
         dx, dy, dz = dirs[i, 0], dirs[i, 1], dirs[i, 2]
         # Emission, MIS-weighted after a diffuse bounce
-        le_max = max(emission[m, 0], max(emission[m, 1], emission[m, 2]))
-        if le_max > 0.0:
-            w = 1.0
-            if bsdf_pdf[i] > 0.0:
-                cos_y = abs(gx * dx + gy * dy + gz * dz)
-                light_pdf = t[i] * t[i] / max(cos_y * em_area, 1e-300)
-                w = bsdf_pdf[i] / (bsdf_pdf[i] + light_pdf)
+        if max(emission[m, 0], max(emission[m, 1], emission[m, 2])) > 0.0:
+            w = _emission_weight(bsdf_pdf[i], t[i], abs(gx * dx + gy * dy + gz * dz), em_area)
             for c in range(3):
                 out[pixel[i], c] += beta[i, c] * emission[m, c] * w
         p_d = (rho[m, 0] + rho[m, 1] + rho[m, 2]) / 3.0
@@ -311,82 +417,24 @@ def path_vertex(out, pixel, beta, bsdf_pdf, position, normal, geo, entering, dir
         prob_d = p_d / total if total > 0.0 else 0.0
         # Next-event estimation: one point on the emitters, by area
         if n_em > 0 and p_d > 0.0:
-            k = np.searchsorted(em_cdf, rnd[i, 0], side="right")
-            k = min(k, n_em - 1)
-            s = math.sqrt(rnd[i, 1])
-            a, b = s * (1.0 - rnd[i, 2]), s * rnd[i, 2]
-            qx = em_p0[k, 0] + a * em_e1[k, 0] + b * em_e2[k, 0] - px
-            qy = em_p0[k, 1] + a * em_e1[k, 1] + b * em_e2[k, 1] - py
-            qz = em_p0[k, 2] + a * em_e1[k, 2] + b * em_e2[k, 2] - pz
-            dist = math.sqrt(qx * qx + qy * qy + qz * qz)
-            if dist > 2.0 * eps:
-                wx, wy, wz = qx / dist, qy / dist, qz / dist
-                cos_x = nx * wx + ny * wy + nz * wz
-                cos_y = abs(em_normal[k, 0] * wx + em_normal[k, 1] * wy + em_normal[k, 2] * wz)
-                if cos_x > 0.0 and gx * wx + gy * wy + gz * wz > 0.0:
-                    light_pdf = dist * dist / max(cos_y * em_area, 1e-300)
-                    scale = cos_x / (light_pdf + prob_d * cos_x / math.pi) / math.pi
-                    nee_ok[i] = True
-                    nee_o[i, 0] = px + eps * gx
-                    nee_o[i, 1] = py + eps * gy
-                    nee_o[i, 2] = pz + eps * gz
-                    nee_d[i, 0], nee_d[i, 1], nee_d[i, 2] = wx, wy, wz
-                    nee_t[i] = dist * (1.0 - 1e-4) - 2.0 * eps
-                    for c in range(3):
-                        nee_val[i, c] = beta[i, c] * rho[m, c] * em_le[k, c] * scale
+            _next_event(i, m, emitters, rho, beta, px, py, pz, nx, ny, nz, gx, gy, gz, prob_d,
+                        eps, rnd, nee_o, nee_d, nee_t, nee_ok, nee_val)
         if total <= 0.0:
             continue
         # Pick a lobe
         u = rnd[i, 3] * total
         side = 1.0
         if u < p_d:  # diffuse: cosine-weighted about the shading normal, weight rho / P
-            r = math.sqrt(rnd[i, 4])
-            phi = 2.0 * math.pi * rnd[i, 5]
-            lx, ly, lz = r * math.cos(phi), r * math.sin(phi), math.sqrt(max(1.0 - rnd[i, 4], 0.0))
-            sign = 1.0 if nz >= 0.0 else -1.0
-            aa = -1.0 / (sign + nz)
-            bb = nx * ny * aa
-            tx, ty, tz = 1.0 + sign * nx * nx * aa, sign * bb, -sign * nx
-            bx, by, bz = bb, sign + ny * ny * aa, -ny
-            ox = lx * tx + ly * bx + lz * nx
-            oy = lx * ty + ly * by + lz * ny
-            oz = lx * tz + ly * bz + lz * nz
+            ox, oy, oz, cos_o = _sample_cosine_hemisphere(rnd[i, 4], rnd[i, 5], nx, ny, nz)
             if ox * gx + oy * gy + oz * gz <= 0.0:
                 continue
-            prob = prob_d
             for c in range(3):
-                new_beta[i, c] = beta[i, c] * rho[m, c] / prob
-            new_pdf[i] = prob * lz / math.pi
+                new_beta[i, c] = beta[i, c] * rho[m, c] / prob_d
+            new_pdf[i] = prob_d * cos_o / math.pi
         else:
-            cos_i = min(max(-(dx * nx + dy * ny + dz * nz), 0.0), 1.0)
-            rx, ry, rz = dx + 2.0 * cos_i * nx, dy + 2.0 * cos_i * ny, dz + 2.0 * cos_i * nz
-            rl = math.sqrt(rx * rx + ry * ry + rz * rz)
-            ox, oy, oz = rx / rl, ry / rl, rz / rl
-            if u < p_d + kr[m]:  # mirror
-                prob = kr[m] / total
-                weight = kr[m]
-            else:  # glass: Fresnel picks reflection or refraction
-                prob = kt[m] / total
-                weight = kt[m]
-                if entering[i]:
-                    n1, n2 = 1.0, ior[m]
-                else:
-                    n1, n2 = ior[m], 1.0
-                eta = n1 / n2
-                kk = 1.0 - eta * eta * (1.0 - cos_i * cos_i)
-                f = 1.0
-                cos_t = 0.0
-                if kk >= 0.0:
-                    cos_t = math.sqrt(kk)
-                    rs = (n1 * cos_i - n2 * cos_t) / max(n1 * cos_i + n2 * cos_t, 1e-300)
-                    rp = (n2 * cos_i - n1 * cos_t) / max(n2 * cos_i + n1 * cos_t, 1e-300)
-                    f = 0.5 * (rs * rs + rp * rp)
-                if rnd[i, 4] >= f:
-                    aa = eta * cos_i - cos_t
-                    tx, ty, tz = eta * dx + aa * nx, eta * dy + aa * ny, eta * dz + aa * nz
-                    tl = math.sqrt(tx * tx + ty * ty + tz * tz)
-                    ox, oy, oz = tx / tl, ty / tl, tz / tl
-                    side = -1.0
+            ox, oy, oz, side, weight, prob = _specular_lobe(u, p_d, kr[m], kt[m], ior[m],
+                                                            entering[i], total, dx, dy, dz,
+                                                            nx, ny, nz, rnd[i, 4])
             for c in range(3):
                 new_beta[i, c] = beta[i, c] * weight / prob
         # Russian roulette

@@ -184,9 +184,10 @@ class PathTracer:
             (nee_o, nee_d, nee_t, nee_ok, nee_val, o, d, beta, bsdf_pdf,
              alive) = kernels.path_vertex(
                 out, pixel, beta, bsdf_pdf, surf.position, surf.normal, surf.geo_normal,
-                surf.entering, np.ascontiguousarray(d), t, mat, self.rho, self.kr, self.kt,
-                self.ior, self.emission, em.cdf, em.p0, em.e1, em.e2, em.normal, em.le,
-                em.total_area, ctx.eps, rng.random((len(t), 7)), bounce >= RR_START)
+                surf.entering, np.ascontiguousarray(d), t, mat,
+                (self.rho, self.kr, self.kt, self.ior, self.emission),
+                (em.cdf, em.p0, em.e1, em.e2, em.normal, em.le, float(em.total_area)),
+                ctx.eps, rng.random((len(t), 7)), bounce >= RR_START)
             cand = np.flatnonzero(nee_ok)
             if len(cand):
                 blocked = ctx.accel.occluded(nee_o[cand], nee_d[cand], nee_t[cand],

@@ -21,13 +21,13 @@ from shadelab.render.textures import TextureCache, has_surface_detail
 from shadelab.render.transparency import draw_transparent
 from shadelab.scene.camera import far_plane, gl_matrix, projection_matrix, view_matrix
 from shadelab.scene.model import MAX_LIGHTS, Light, Material, Scene
+from shadelab.shading.codes import ATTENUATION_CODES, LIGHT_KIND_CODES, SPECULAR_CODES
+from shadelab.shading.lights import pack_lights
 
 SHADING_PROGRAMS = ("flat", "gouraud", "phong")
 # Variants with texture-mapped Od and bump maps (a geometry shader adds the tangents); only
 # materials with a texture or a bump use them, so every other material keeps its output.
 TEXTURED_PROGRAMS = {name: f"{name}_tex" for name in SHADING_PROGRAMS}
-LIGHT_KIND_CODES = {"point": 0, "directional": 1, "spot": 2}
-ATTENUATION_CODES = {"none": 0, "inverse_square": 1, "lecture": 2}
 
 
 @dataclass
@@ -96,7 +96,7 @@ class Renderer:
         attenuations = sum(att << (2 * i) for i, (_, att) in enumerate(codes))
         return {"NUM_LIGHTS": len(codes), "LIGHT_KINDS": f"{kinds}u",
                 "LIGHT_ATTENUATIONS": f"{attenuations}u",
-                "SPECULAR_MODEL": 1 if model == "blinn" else 0}
+                "SPECULAR_MODEL": SPECULAR_CODES[model]}
 
     def programs_for_lights(self, lights: list[Light], specular: str) -> dict:
         """Every shading program compiled for this light configuration (cached).
@@ -175,7 +175,7 @@ class Renderer:
         set_uniform(program, "u_clip_from_world", gl_matrix(view.clip_from_world))
         set_uniform(program, "u_eye", tuple(view.eye))
         set_uniform(program, "u_Ia", tuple(scene.Ia))
-        set_uniform(program, "u_specular_model", 1 if specular == "blinn" else 0)
+        set_uniform(program, "u_specular_model", SPECULAR_CODES[specular])
         write_light_uniforms(program, scene.active_lights())
 
     @staticmethod
@@ -330,30 +330,20 @@ def is_transparent(material: Material) -> bool:
 
 def write_light_uniforms(program: moderngl.Program, lights: list[Light],
                          shadow: list[float] | None = None) -> None:
-    """Fill the ``u_light_*`` arrays of ``lighting.glsl`` (padded to MAX_LIGHTS)."""
+    """Fill the ``u_light_*`` arrays of ``lighting.glsl`` (padded to MAX_LIGHTS) from
+    :func:`shadelab.shading.lights.pack_lights`, the packing the ray tracer's table uses."""
     count = min(len(lights), MAX_LIGHTS)
-    kinds = np.zeros(MAX_LIGHTS, np.int32)
-    att = np.zeros(MAX_LIGHTS, np.int32)
-    pos = np.zeros((MAX_LIGHTS, 3), np.float32)
-    direction = np.zeros((MAX_LIGHTS, 3), np.float32)
-    ip = np.zeros((MAX_LIGHTS, 3), np.float32)
-    c = np.zeros((MAX_LIGHTS, 3), np.float32)
-    spot = np.zeros((MAX_LIGHTS, 2), np.float32)
+    packed = pack_lights(lights[:count])
     s = np.ones(MAX_LIGHTS, np.float32)
-    for i, light in enumerate(lights[:count]):
-        kinds[i] = LIGHT_KIND_CODES[light.kind]
-        att[i] = ATTENUATION_CODES[light.attenuation]
-        pos[i] = light.position
-        d = np.asarray(light.direction, dtype=np.float64)
-        direction[i] = d / max(np.linalg.norm(d), 1e-30)
-        ip[i] = light.Ip
-        c[i] = (light.c1, light.c2, light.c3)
-        spot[i] = (math.cos(math.radians(light.cone_angle)), light.spot_exponent)
-        if shadow is not None:
-            s[i] = shadow[i]
+    if shadow is not None:
+        s[:count] = shadow[:count]
     set_uniform(program, "u_num_lights", count)
-    for name, array in (("u_light_kind", kinds), ("u_light_attenuation", att),
-                        ("u_light_position", pos), ("u_light_direction", direction),
-                        ("u_light_Ip", ip), ("u_light_c", c), ("u_light_spot", spot),
-                        ("u_light_S", s)):
-        set_uniform_array(program, name, array)
+    for name, array in (("u_light_kind", packed.kind), ("u_light_attenuation", packed.attenuation),
+                        ("u_light_position", packed.position),
+                        ("u_light_direction", packed.direction), ("u_light_Ip", packed.Ip),
+                        ("u_light_c", packed.c), ("u_light_spot", packed.spot)):
+        padded = np.zeros((MAX_LIGHTS, *array.shape[1:]), array.dtype)
+        padded[:count] = array
+        set_uniform_array(program, name, padded.astype(np.int32 if array.dtype.kind == "i"
+                                                       else np.float32))
+    set_uniform_array(program, "u_light_S", s)

@@ -11,9 +11,41 @@ from __future__ import annotations
 
 import numpy as np
 
+# The sRGB transfer function (IEC 61966-2-1); shaders/include/color.glsl gets these values as
+# generated #defines (glsl_header), so the shader and the PNG writer encode alike.
+SRGB_LINEAR_MAX = 0.0031308  # linear values up to here are scaled, above: a power law
+SRGB_SLOPE = 12.92  # the linear segment's slope
+SRGB_SCALE = 1.055  # the power segment: SCALE * c^(1 / GAMMA) - OFFSET
+SRGB_OFFSET = 0.055
+SRGB_GAMMA = 2.4
+# The difference heat map: black -> blue -> green -> yellow -> red as t goes 0 -> 1
+HEAT_STOPS = ((0.0, 0.0, 0.0), (0.0, 0.0, 1.0), (0.0, 1.0, 0.0), (1.0, 1.0, 0.0), (1.0, 0.0, 0.0))
+HEAT_EPS = 1e-12  # guard of the heat map's full-scale difference
+
 
 def to_srgb8(linear: np.ndarray, exposure: float = 1.0) -> np.ndarray:
     """Linear RGB (H, W, 3) -> sRGB uint8, clipped to [0, 1] after exposure."""
     c = np.clip(np.nan_to_num(linear * exposure, nan=0.0, posinf=1.0), 0.0, 1.0)
-    srgb = np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
+    srgb = np.where(c <= SRGB_LINEAR_MAX, SRGB_SLOPE * c,
+                    SRGB_SCALE * np.power(c, 1.0 / SRGB_GAMMA) - SRGB_OFFSET)
     return np.round(srgb * 255.0).astype(np.uint8)
+
+
+def heat_map(a: np.ndarray, b: np.ndarray, scale: float) -> np.ndarray:
+    """(H, W, 3) uint8: max-channel |a - b| / scale through black-blue-green-yellow-red."""
+    t = np.clip(np.abs(a - b).max(axis=-1) / max(scale, HEAT_EPS), 0.0, 1.0) * 4.0
+    stops = np.array(HEAT_STOPS, np.float64)
+    i = np.minimum(t.astype(int), 3)
+    f = (t - i)[..., None]
+    return np.round((stops[i] * (1 - f) + stops[i + 1] * f) * 255).astype(np.uint8)
+
+
+def glsl_header() -> str:
+    """The sRGB and heat-map constants as ``#define`` lines (for shaders/include/color.glsl)."""
+    defines = {"SRGB_LINEAR_MAX": SRGB_LINEAR_MAX, "SRGB_SLOPE": SRGB_SLOPE,
+               "SRGB_SCALE": SRGB_SCALE, "SRGB_OFFSET": SRGB_OFFSET, "SRGB_GAMMA": SRGB_GAMMA,
+               "HEAT_EPS": HEAT_EPS}
+    lines = [f"#define {name} {value!r}" for name, value in defines.items()]
+    lines += [f"#define HEAT_STOP_{k} vec3({', '.join(map(repr, stop))})"
+              for k, stop in enumerate(HEAT_STOPS)]
+    return "// Generated from shadelab/shading/conventions.py.\n" + "\n".join(lines) + "\n"

@@ -14,9 +14,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from shadelab.constants import SHADING_EPS as _EPS
 from shadelab.scene.model import Light, Material
-
-_EPS = 1e-12
+from shadelab.shading.codes import ATTENUATION_CODES  # noqa: F401  (re-exported)
 
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -82,9 +82,6 @@ def blinn_phong_specular(n: np.ndarray, to_light: np.ndarray, to_eye: np.ndarray
     """
     lit = _dot(n, to_light) > 0.0
     return np.where(lit, _power(_dot(n, halfway(to_light, to_eye)), shininess), 0.0)
-
-
-ATTENUATION_CODES = {"none": 0, "inverse_square": 1, "lecture": 2}
 
 
 def attenuation(distance: np.ndarray, mode: str, c1: float, c2: float, c3: float) -> np.ndarray:

@@ -6,22 +6,13 @@ import numpy as np
 from imgui_bundle import imgui
 
 from shadelab.scene.preset import clone_scene
-from shadelab.shading.conventions import to_srgb8
+from shadelab.shading.conventions import heat_map, to_srgb8
 from shadelab.ui import panels
 from shadelab.ui.jobs import available_jobs, difference
 from shadelab.ui.state import AppState
 
 SIZES = (32, 64, 96, 128, 192, 256, 384, 512)
 SAMPLES = (1, 4, 16, 64, 256)
-
-
-def heat_map(a: np.ndarray, b: np.ndarray, scale: float) -> np.ndarray:
-    """(H, W, 3) uint8: max-channel |a - b| / scale through black-blue-green-yellow-red."""
-    t = np.clip(np.abs(a - b).max(axis=-1) / max(scale, 1e-12), 0.0, 1.0) * 4.0
-    stops = np.array([[0, 0, 0], [0, 0, 1], [0, 1, 0], [1, 1, 0], [1, 0, 0]], np.float64)
-    i = np.minimum(t.astype(int), 3)
-    f = (t - i)[..., None]
-    return np.round((stops[i] * (1 - f) + stops[i + 1] * f) * 255).astype(np.uint8)
 
 
 def kinds(state: AppState):

@@ -1,0 +1,37 @@
+"""The integer codes that the lighting equation's switches take on the GPU and in the numba
+kernels: one table, from which the GLSL ``#define``s are generated (``LIGHT_POINT`` ...,
+see :func:`glsl_defines` and :func:`shadelab.gl.programs.register_includes`), so no copy of
+a code is written by hand anywhere else.
+"""
+
+from __future__ import annotations
+
+from shadelab.constants import SHADING_EPS
+from shadelab.scene.model import ATTENUATION_MODES, LIGHT_KINDS, MAX_LIGHTS, SPECULAR_MODELS
+
+LIGHT_KIND_CODES = {"point": 0, "directional": 1, "spot": 2}  # Light.kind
+ATTENUATION_CODES = {"none": 0, "inverse_square": 1, "lecture": 2}  # Light.attenuation
+SPECULAR_CODES = {"phong": 0, "blinn": 1}  # (R.V)^n or (N.H)^n
+
+assert tuple(LIGHT_KIND_CODES) == LIGHT_KINDS
+assert tuple(ATTENUATION_CODES) == ATTENUATION_MODES
+assert tuple(SPECULAR_CODES) == SPECULAR_MODELS
+
+# GLSL name prefix of each table: LIGHT_SPOT, ATTENUATION_LECTURE, SPECULAR_BLINN
+_GLSL_TABLES = (("LIGHT", LIGHT_KIND_CODES), ("ATTENUATION", ATTENUATION_CODES),
+                ("SPECULAR", SPECULAR_CODES))
+
+
+def glsl_defines() -> dict[str, object]:
+    """Every code as a GLSL ``#define`` (name -> value), with MAX_LIGHTS and SHADING_EPS."""
+    defines: dict[str, object] = {"MAX_LIGHTS": MAX_LIGHTS, "SHADING_EPS": repr(SHADING_EPS)}
+    for prefix, table in _GLSL_TABLES:
+        defines.update({f"{prefix}_{name.upper()}": code for name, code in table.items()})
+    return defines
+
+
+def glsl_header() -> str:
+    """The ``#define`` lines of :func:`glsl_defines`, for the head of an include."""
+    lines = [f"#define {name} {value}" for name, value in glsl_defines().items()]
+    return "// Generated from shadelab/shading/codes.py and shadelab/constants.py.\n" + \
+        "\n".join(lines) + "\n"
