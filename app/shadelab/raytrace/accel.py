@@ -17,11 +17,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from shadelab.constants import T_INF  # noqa: F401  (re-exported: accel.T_INF)
 from shadelab.geometry.mesh import MeshData, scene_meshes
 from shadelab.raytrace import BACKENDS  # noqa: F401  (re-exported: accel.BACKENDS)
 from shadelab.scene.model import Scene
-
-T_INF = 1e30  # "no hit" distance, world units
 
 
 @dataclass
