@@ -1,0 +1,325 @@
+"""Presenter mode: fullscreen (F11), the viewport alone (Tab) with a caption, line widths
+that scale with the presenter scale, an fps readout, and the display options (tone map,
+clipping indicator, anti-aliasing).
+
+The Viewer calls :func:`end_frame` once a frame and :func:`draw_viewport_extras` after the
+viewport image; the Scene panel shows :func:`draw_display_panel`.
+"""
+
+from __future__ import annotations
+
+from imgui_bundle import hello_imgui, imgui
+
+from shadelab.ui.state import AppState
+
+PRESENTER_SCALE = 1.8          # font scale of presenter mode (ui/app.py applies it)
+LINE_PX = 1.5                  # overlay line width at font scale 1, pixels
+PRESENTER_LINE_PX = 3.5        # ... in presenter mode (>= 3 px: seen from the back row)
+TONEMAPS = ("clamp", "reinhard")
+TONEMAP_LABELS = {"clamp": "clamp to [0, 1]", "reinhard": "Reinhard x / (1 + x)"}
+CAPTION_COLOR = 0xFFFFFFFF
+CAPTION_SHADOW = 0xC0000000
+PRESENTER_WINDOW = "##presenter viewport"
+
+
+def line_px(state: AppState) -> float:
+    """Overlay line width on screen, pixels: grows with the presenter scale."""
+    if state.line_width > 0:
+        return state.line_width
+    return PRESENTER_LINE_PX if state.presenter else LINE_PX
+
+
+def font_scale(state: AppState) -> float:
+    return PRESENTER_SCALE if state.presenter else 1.0
+
+
+# ---------------------------------------------------------------- shortcut actions
+
+
+def toggle_panels(state: AppState) -> None:
+    state.hide_panels = not state.hide_panels
+
+
+def toggle_fullscreen(state: AppState) -> None:
+    state.fullscreen = not state.fullscreen
+
+
+# ---------------------------------------------------------------- fullscreen
+
+
+_applied_fullscreen = False
+_windowed_geometry: tuple[int, int, int, int] | None = None
+
+
+def apply_fullscreen(state: AppState) -> None:
+    """Switch the GLFW window to the monitor's resolution and back when ``state.fullscreen``
+    changed (the window's monitor: the one under its centre)."""
+    global _applied_fullscreen, _windowed_geometry
+    if state.fullscreen == _applied_fullscreen:
+        return
+    _applied_fullscreen = state.fullscreen
+    try:
+        import glfw
+        from imgui_bundle import glfw_utils
+
+        window = glfw_utils.glfw_window_hello_imgui()
+        if state.fullscreen:
+            x, y = glfw.get_window_pos(window)
+            w, h = glfw.get_window_size(window)
+            _windowed_geometry = (x, y, w, h)
+            monitor = monitor_of(glfw, (x + w // 2, y + h // 2))
+            mode = glfw.get_video_mode(monitor)
+            glfw.set_window_monitor(window, monitor, 0, 0, mode.size.width, mode.size.height,
+                                    mode.refresh_rate)
+        else:
+            x, y, w, h = _windowed_geometry or (40, 40, 1600, 900)
+            glfw.set_window_monitor(window, None, x, y, w, h, 0)
+        state.status = "fullscreen" if state.fullscreen else "windowed"
+    except Exception as exc:  # no GLFW window (a mock backend): say so, keep running
+        state.error = f"fullscreen: {exc}"
+
+
+def mark_fullscreen_applied() -> None:
+    """The window opens fullscreen (hello_imgui's window params did it)."""
+    global _applied_fullscreen
+    _applied_fullscreen = True
+
+
+def monitor_of(glfw, point: tuple[int, int]):
+    for monitor in glfw.get_monitors() or []:
+        mx, my = glfw.get_monitor_pos(monitor)
+        mode = glfw.get_video_mode(monitor)
+        if mx <= point[0] < mx + mode.size.width and my <= point[1] < my + mode.size.height:
+            return monitor
+    return glfw.get_primary_monitor()
+
+
+# ---------------------------------------------------------------- panels hidden (Tab)
+
+
+_hidden_labels: list[str] = []
+
+
+def apply_panel_visibility(state: AppState) -> None:
+    """Tab: every dock window hidden (the viewport is drawn in a window of its own)."""
+    global _hidden_labels
+    windows = hello_imgui.get_runner_params().docking_params.dockable_windows
+    if state.hide_panels and not _hidden_labels:
+        _hidden_labels = [w.label for w in windows if w.is_visible]
+        for w in windows:
+            w.is_visible = False
+    elif not state.hide_panels and _hidden_labels:
+        for w in windows:
+            if w.label in _hidden_labels:
+                w.is_visible = True
+        _hidden_labels = []
+
+
+def draw_presenter_viewport(viewer) -> None:
+    """With the panels hidden: the viewport over the whole window."""
+    state = viewer.state
+    if not state.hide_panels:
+        return
+    vp = imgui.get_main_viewport()
+    imgui.set_next_window_pos(vp.work_pos)
+    imgui.set_next_window_size(vp.work_size)
+    imgui.push_style_var(imgui.StyleVar_.window_padding, imgui.ImVec2(0, 0))
+    imgui.push_style_var(imgui.StyleVar_.window_border_size, 0.0)
+    flags = (imgui.WindowFlags_.no_decoration | imgui.WindowFlags_.no_move
+             | imgui.WindowFlags_.no_saved_settings | imgui.WindowFlags_.no_docking
+             | imgui.WindowFlags_.no_bring_to_front_on_focus
+             | imgui.WindowFlags_.no_scroll_with_mouse)
+    imgui.begin(PRESENTER_WINDOW, None, flags)
+    imgui.pop_style_var(2)
+    try:
+        from shadelab.ui.frame import guarded
+
+        guarded(viewer.draw_viewport_window, "viewport", viewer.report_error)
+    finally:
+        imgui.end()
+
+
+# ---------------------------------------------------------------- layout that fits
+
+
+NARROW_EM = 95.0     # below this many font heights of window width, one side column
+DOCK_RATIOS = {"wide": {"LeftSpace": 0.24, "RightSpace": 0.36, "RightBottom": 0.40},
+               "narrow": {"LeftSpace": 0.46, "RightSpace": 0.36, "RightBottom": 0.40}}
+_layout = "wide"
+_home: dict[str, str] = {}   # window label -> its dock space in the wide layout
+
+
+def layout_for(width: float, font_px: float) -> str:
+    """'narrow' (the right column's panels join the left one, which widens) when the window
+    is less than NARROW_EM font heights wide, else 'wide'."""
+    return "narrow" if width < NARROW_EM * font_px else "wide"
+
+
+def apply_layout(state: AppState) -> str:
+    """Re-dock the panels when the window's width in font heights crosses NARROW_EM (a
+    projector at 1024x768, presenter fonts), so labels and tables keep their room."""
+    global _layout
+    io = imgui.get_io()
+    font_px = imgui.get_style().font_size_base * font_scale(state)
+    wanted = layout_for(io.display_size.x, font_px)
+    if wanted == _layout:
+        return _layout
+    params = hello_imgui.get_runner_params().docking_params
+    if not _home:
+        _home.update({w.label: w.dock_space_name for w in params.dockable_windows})
+    for split in params.docking_splits:
+        split.ratio = DOCK_RATIOS[wanted].get(split.new_dock, split.ratio)
+    for w in params.dockable_windows:
+        home = _home.get(w.label, w.dock_space_name)
+        w.dock_space_name = "LeftSpace" if wanted == "narrow" and home.startswith("Right") \
+            else home
+    params.layout_reset = True
+    _layout = wanted
+    return wanted
+
+
+# ---------------------------------------------------------------- in the viewport
+
+
+def caption_text(state: AppState) -> str:
+    """The lesson step's caption, or (panels hidden) the current equation and mode."""
+    if state.lesson is not None and state.lesson.step is not None:
+        return state.lesson.caption()
+    if not state.hide_panels:
+        return ""
+    from shadelab.ui.panels import EQUATION, EQUATION_BLINN, SHADING_LABELS
+
+    render = state.scene.render
+    equation = EQUATION_BLINN if render.specular == "blinn" else EQUATION
+    mode = f"{SHADING_LABELS[render.shading]} shading"
+    pipeline = getattr(state, "pipeline", "")
+    if pipeline:
+        mode += f", pipeline {pipeline}"
+    if render.shadows != "none":
+        mode += ", shadows"
+    return f"{equation}\n{mode}  -  Tab: panels"
+
+
+def draw_caption(draw, text: str, origin, size, scale: float) -> None:
+    """Large caption at the viewport's bottom, wrapped to its width, on a dark band."""
+    if not text:
+        return
+    font = imgui.get_font()
+    font_size = imgui.get_font_size() * scale
+    pad = 10.0 * scale / 1.4
+    wrap = max(size[0] - 2 * pad, 50.0)
+    text_size = font.calc_text_size_a(font_size, 1e9, wrap, text)
+    x, y = origin.x + pad, origin.y + size[1] - text_size.y - 2 * pad
+    draw.add_rect_filled(imgui.ImVec2(origin.x, y - pad / 2),
+                         imgui.ImVec2(origin.x + size[0], origin.y + size[1]), 0xA0000000)
+    draw.add_text(font, font_size, imgui.ImVec2(x + 1, y + 1), CAPTION_SHADOW, text, wrap)
+    draw.add_text(font, font_size, imgui.ImVec2(x, y), CAPTION_COLOR, text, wrap)
+
+
+def draw_viewport_extras(state: AppState, origin, size, redrawn: bool) -> None:
+    """Caption and fps readout over the viewport image (origin: its top-left, screen)."""
+    draw = imgui.get_window_draw_list()
+    if state.show_fps:
+        io = imgui.get_io()
+        fps = io.framerate
+        text = f"{fps:5.1f} fps  {1000.0 / max(fps, 1e-6):5.1f} ms" \
+               + ("  redrawn" if redrawn else "")
+        width = imgui.calc_text_size(text).x
+        pos = imgui.ImVec2(origin.x + size[0] - width - 8, origin.y + 4)
+        draw.add_rect_filled(imgui.ImVec2(pos.x - 4, pos.y - 2),
+                             imgui.ImVec2(pos.x + width + 4, pos.y + imgui.get_font_size() + 2),
+                             0x90000000)
+        draw.add_text(pos, 0xFFB0FFB0, text)
+    caption = caption_text(state)
+    big = 1.4 if state.lesson is not None else 1.0
+    draw_caption(draw, caption, origin, size, big)
+
+
+# ---------------------------------------------------------------- Scene panel section
+
+
+def draw_display_panel(state: AppState) -> bool:
+    """Display options (not part of the scene): tone map, clipping, AA, lines, fps."""
+    if not imgui.collapsing_header("Display and presenter"):
+        return False
+    imgui.text("Tone map")
+    for name in TONEMAPS:
+        if same_line_if_fits(TONEMAP_LABELS[name], radio=True):
+            imgui.same_line()
+        if imgui.radio_button(TONEMAP_LABELS[name], state.tonemap == name):
+            state.tonemap = name
+    _, state.show_clipping = imgui.checkbox("Show clipped pixels (stripes)", state.show_clipping)
+    aa = state.antialias > 1
+    changed, aa = imgui.checkbox("Anti-aliasing (2x2 supersampling)", aa)
+    if changed:
+        state.antialias = 2 if aa else 1
+    _, state.show_fps = imgui.checkbox("fps readout", state.show_fps)
+    _, state.line_width = imgui.slider_float("line width (0: auto)", state.line_width, 0.0, 8.0,
+                                             "%.1f px")
+    _, state.show_gizmos = imgui.checkbox("Light gizmos", state.show_gizmos)
+    _, state.hide_panels = imgui.checkbox("Viewport only (Tab)", state.hide_panels)
+    _, state.fullscreen = imgui.checkbox("Fullscreen (F11)", state.fullscreen)
+    return False
+
+
+def same_line_if_fits(label: str, radio: bool = False) -> bool:
+    """True when a button (or, ``radio``, a radio button / checkbox) labelled ``label`` fits
+    on the line after the last item; else it goes on the next line (narrow panels wrap)."""
+    style = imgui.get_style()
+    text = imgui.calc_text_size(label.split("##")[0]).x
+    needed = text + style.item_spacing.x + (
+        imgui.get_frame_height() + style.item_inner_spacing.x if radio
+        else 2 * style.frame_padding.x)
+    last = imgui.get_item_rect_max().x
+    # The cursor is at the start of the next line: its x plus the space left is the right edge.
+    right = imgui.get_cursor_screen_pos().x + imgui.get_content_region_avail().x
+    return last + needed <= right
+
+
+# ---------------------------------------------------------------- per frame
+
+
+def end_frame(viewer) -> None:
+    """Fullscreen, panel visibility, dialogs, drops, stale overlays, panel focus."""
+    from shadelab.ui import dialogs
+
+    state = viewer.state
+    apply_fullscreen(state)
+    apply_layout(state)
+    apply_panel_visibility(state)
+    draw_presenter_viewport(viewer)
+    dialogs.poll(state)
+    dialogs.take_dropped(state)
+    dialogs.draw_discard_question(state)
+    drop_stale_overlays(state)
+    if state.focus_request:
+        from shadelab.ui.app import focus_windows
+
+        focus_windows(hello_imgui.get_runner_params().docking_params.dockable_windows,
+                      state.focus_request)
+        state.focus_request = ""
+
+
+_last_version: int = -1
+
+
+def drop_stale_overlays(state: AppState) -> None:
+    """Ray tree and radiosity solution belong to the scene the job rendered: once the scene
+    (not just the camera) differs from it, they are cleared."""
+    global _last_version
+    if state.scene_version == _last_version:
+        return
+    _last_version = state.scene_version
+    if state.job_scene is None or (state.ray_tree is None and state.radiosity_soup is None):
+        return
+    from shadelab.scene.preset import scene_to_dict
+
+    now, then = scene_to_dict(state.scene), scene_to_dict(state.job_scene)
+    now.pop("camera", None)
+    then.pop("camera", None)
+    if now != then:
+        state.ray_tree = state.ray_tree_pixel = None
+        state.radiosity_soup = None
+        state.show_radiosity = False
+        state.overlay_version += 1
+        state.status = "the scene changed: ray tree and radiosity solution cleared (run again)"
