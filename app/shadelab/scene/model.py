@@ -70,9 +70,7 @@ class Checked:
                 specs = _SPECCED[type(self)] = {f.name for f in fields(self)
                                                if "spec" in f.metadata}
             if name in specs:
-                from shadelab.scene.preset import _check  # preset imports this module
-
-                value = _check(type(self), name, value, type(self).__name__, name)
+                value = _VALIDATE(type(self), name, value, type(self).__name__, name)
         object.__setattr__(self, name, value)
 
     def __post_init__(self) -> None:
@@ -80,6 +78,10 @@ class Checked:
 
 
 _SPECCED: dict[type, set[str]] = {}
+# The preset loader's value check, (cls, key, value, source, where) -> canonical value. The
+# package (shadelab/scene/__init__.py) sets it once preset.py is loaded: preset imports this
+# module, so this module cannot import preset back without a cycle.
+_VALIDATE: Any = None
 
 
 @dataclass
