@@ -45,11 +45,12 @@ def machine() -> dict:
     info = {"cpu": cpu, "cores": os.cpu_count(), "python": sys.version.split()[0],
             "platform": platform.platform()}
     try:
-        from shadelab.gl.context import headless_context
+        from shadelab.gl.context import context_info, headless_context
 
-        ctx = headless_context()
-        info["gl_renderer"] = ctx.info["GL_RENDERER"]
-        info["gl_version"] = ctx.info["GL_VERSION"]
+        gl = context_info(headless_context())
+        info["gl_backend"] = gl["backend"]  # egl or native (GLX, WGL, CGL); SHADELAB_GL
+        info["gl_renderer"] = gl["renderer"]
+        info["gl_version"] = gl["version"]
     except Exception as exc:  # the bench still reports CPU sections without GL
         info["gl_renderer"] = f"unavailable: {exc}"
     return info

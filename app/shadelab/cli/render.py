@@ -33,6 +33,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--error", type=float, metavar="BUDGET",
                    help="auto quality: tessellate each sphere no finer than this relative MSE "
                         "needs (e.g. 0.01; see shadelab.studies.autoquality)")
+    p.add_argument("-v", "--verbose", action="store_true",
+                   help="print the OpenGL context used (egl or native, SHADELAB_GL) and its "
+                        "renderer")
     p.set_defaults(run=run_render)
 
     p = sub.add_parser("presets", help="list the presets shipped with ShadeLab")
@@ -72,6 +75,11 @@ def run_render(args: argparse.Namespace) -> int:
             print(line)
 
     image = render_image(scene, size, args.shading, args.specular)
+    if getattr(args, "verbose", False):
+        from shadelab.gl.context import context_info, headless_context
+
+        gl = context_info(headless_context())
+        print(f"gl: {gl['backend']}, {gl['renderer']}, OpenGL {gl['version']}")
     save_outputs(args, image, scene.render.exposure)
     print(f"wrote {args.output} ({size[0]}x{size[1]}, {args.shading or scene.render.shading})")
     return 0
