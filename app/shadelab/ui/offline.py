@@ -9,6 +9,7 @@ from shadelab.scene.preset import clone_scene
 from shadelab.shading.conventions import heat_map, to_srgb8
 from shadelab.ui import panels
 from shadelab.ui.jobs import available_jobs, difference
+from shadelab.ui.pipelines import object_label
 from shadelab.ui.state import AppState
 
 SIZES = (32, 64, 96, 128, 192, 256, 384, 512)
@@ -145,7 +146,8 @@ def draw_ray_tree(state: AppState) -> None:
                                  else "")
             imgui.text("  " * depth + label)
             imgui.table_next_column()
-            imgui.text("miss" if node.end is None else f"object {node.object}")
+            imgui.text("miss" if node.end is None
+                       else object_label(state.job_scene, node.object))  # name (material)
             imgui.table_next_column()
             imgui.text(_rgb(node.weight))
             imgui.table_next_column()
@@ -155,6 +157,27 @@ def draw_ray_tree(state: AppState) -> None:
 
 def _rgb(v) -> str:
     return "(" + ", ".join(f"{float(c):.3g}" for c in np.asarray(v).reshape(-1)[:3]) + ")"
+
+
+VIEWPORT_PIPELINE = {"Whitted": "raytrace", "Path": "pathtrace", "Radiosity": "radiosity"}
+
+
+def work_done(latest) -> str:
+    """Progress in the job's own units: rays traced, paths sampled, patches and shots."""
+    if latest is None:
+        return ""
+    stats = latest.stats or {}
+    if "samples" in stats:
+        return f"{int(stats['samples']):,} samples, {int(stats.get('rays', 0)):,} rays"
+    if "rays" in stats:
+        return f"{int(stats['rays']):,} rays"
+    if "paths" in stats:
+        return f"{int(stats['paths']):,} paths"
+    if "patches" in stats:
+        history = stats.get("history") or {}
+        shots = len(history.get("iteration", [])) if isinstance(history, dict) else 0
+        return f"{stats['patches']} patches, {shots} iterations/shots"
+    return latest.message
 
 
 def draw_offline_panel(state: AppState) -> bool:
@@ -188,8 +211,13 @@ def draw_offline_panel(state: AppState) -> bool:
         if job.error:
             word = "failed"
         imgui.progress_bar(fraction, imgui.ImVec2(-1, 0),
-                           f"{job.name}: {word} {fraction * 100:.0f}%")
+                           f"{job.name}: {word} {work_done(latest)}")
         imgui.text(f"elapsed {job.elapsed:.1f} s   {latest.message if latest else ''}")
+        target = VIEWPORT_PIPELINE.get(kind.label.split(" ")[0])
+        if target is not None and imgui.small_button("Show in viewport"):
+            from shadelab.ui.pipelines import set_pipeline
+
+            set_pipeline(state, target)  # the same renderer at the viewport's resolution
     if job.error:
         imgui.push_text_wrap_pos(0.0)
         imgui.text_colored(panels.ERROR_COLOR, job.error)

@@ -37,7 +37,9 @@ def field_spec(cls, name: str) -> tuple:
 
 def _show_refusal(key: str) -> None:
     if key in _refused:
+        imgui.push_text_wrap_pos(0.0)
         imgui.text_colored(ERROR_COLOR, _refused[key])
+        imgui.pop_text_wrap_pos()
 
 
 def int_field(label: str, obj, name: str, lo: int | None = None, hi: int | None = None,
@@ -157,7 +159,80 @@ def draw_algorithms_panel(state: AppState) -> bool:
         _show_refusal("path_spp")
     if imgui.collapsing_header("Radiosity", imgui.TreeNodeFlags_.default_open):
         edited |= draw_radiosity_controls(state)
+    draw_pipeline_figures(state)
     return edited
+
+
+def draw_pipeline_figures(state: AppState) -> None:
+    """The running pipeline's figures: the radiosity residual curve, the picked ray tree."""
+    view = state.pipeline_view
+    if view is None:
+        return
+    name = pipelines.current(state)
+    if name == "radiosity" and view.history.get("iteration"):
+        _draw_residual_plot(view)
+    if name == "raytrace":
+        if view.ray_tree is None:
+            imgui.text_colored(DIM_COLOR, "click a pixel of the ray-traced viewport: its ray "
+                                          "tree is drawn there")
+            return
+        draw_ray_tree_table(state, view)
+
+
+def _draw_residual_plot(view) -> None:
+    import numpy as np
+    from imgui_bundle import implot
+
+    h = view.history
+    x = np.asarray(h["iteration"], np.float64)
+    unshot = np.asarray(h["unshot"], np.float64)
+    residual = np.asarray(h["residual"], np.float64)
+    y, label = (unshot, "unshot energy") if np.isnan(residual).all() else (residual, "residual")
+    keep = np.isfinite(y) & (y > 0)
+    if implot.begin_plot("radiosity convergence", imgui.ImVec2(-1, 200)):
+        implot.setup_axes("shot / iteration", label, implot.AxisFlags_.auto_fit,
+                          implot.AxisFlags_.auto_fit)
+        implot.setup_axis_scale(implot.ImAxis_.y1, implot.Scale_.log10)
+        if keep.any():
+            implot.plot_line(label, x[keep], y[keep])
+        implot.end_plot()
+    shooter = view.stats.get("shooter_index")
+    imgui.text(f"{view.stats.get('patches', 0)} patches, {view.stats.get('shots', 0)} shots"
+               + (f", shooting patch {shooter}" if shooter is not None else "")
+               + (", form factors reused" if view.stats.get("form_factors_reused") else ""))
+
+
+def draw_ray_tree_table(state: AppState, view) -> None:
+    root = view.ray_tree
+    deepest = max(node.depth for _, node in root.flatten())
+    imgui.text(f"ray tree of pixel {view.ray_tree_pixel}: {sum(1 for _ in root.flatten())} "
+               f"rays, depth {deepest}")
+    shown = min(view.tree_depth, deepest)
+    changed, shown = imgui.slider_int("show generations up to", shown, 0, max(deepest, 0))
+    if changed:
+        view.tree_depth = shown
+    if imgui.small_button("Clear ray tree"):
+        view.ray_tree = None
+        return
+    flags = imgui.TableFlags_.borders | imgui.TableFlags_.row_bg | imgui.TableFlags_.scroll_y
+    if imgui.begin_table("pipeline_raytree", 3, flags, imgui.ImVec2(0, 180)):
+        for head in ("ray", "hit (material)", "contribution"):
+            imgui.table_setup_column(head)
+        imgui.table_headers_row()
+        for depth, node in root.flatten():
+            if node.depth > view.tree_depth:
+                continue
+            imgui.table_next_row()
+            imgui.table_next_column()
+            label = node.kind + (f" to light {node.light}: S={node.shadow:g}"
+                                 if node.kind == "shadow" else f" d{node.depth}")
+            imgui.text("  " * depth + label)
+            imgui.table_next_column()
+            imgui.text("miss" if node.end is None
+                       else pipelines.object_label(view.job_scene, node.object))
+            imgui.table_next_column()
+            imgui.text(", ".join(f"{float(c):.3g}" for c in node.contribution))
+        imgui.end_table()
 
 
 def draw_raster_controls(state: AppState) -> bool:
