@@ -8,13 +8,13 @@ import time
 
 import numpy as np
 
-from shadelab.timing import median_time
 from shadelab.raytrace.accel import BvhAccel, EmbreeAccel, embree_available, scene_geometry
 from shadelab.raytrace.pathtrace import PathTracer
 from shadelab.raytrace.surface import TraceContext
 from shadelab.raytrace.whitted import iter_raytrace
 from shadelab.scene.camera import primary_rays
 from shadelab.scene.preset import load_preset
+from shadelab.timing import median_time
 
 
 def _cpu_ms(fn, repeats: int) -> float:

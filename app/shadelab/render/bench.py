@@ -9,7 +9,6 @@ import time
 import moderngl
 import numpy as np
 
-from shadelab.timing import median_time
 from shadelab.geometry.mesh import scene_meshes
 from shadelab.gl.context import create_headless_context, headless_context, make_current
 from shadelab.gl.programs import load_program, set_uniform
@@ -17,6 +16,7 @@ from shadelab.gl.target import RenderTarget, release_framebuffer
 from shadelab.render.renderer import Renderer, make_view, triangle_soup
 from shadelab.scene.camera import gl_matrix
 from shadelab.scene.preset import list_presets, load_preset
+from shadelab.timing import median_time
 
 SIZE = (800, 600)
 

@@ -7,11 +7,11 @@ reports the shadow-volume geometry sizes and the other shadow presets for contex
 
 from __future__ import annotations
 
-from shadelab.timing import median_time
 from shadelab.gl.context import headless_context
 from shadelab.gl.target import RenderTarget
 from shadelab.render.renderer import Renderer
 from shadelab.scene.preset import load_preset
+from shadelab.timing import median_time
 
 SIZE = (800, 600)
 

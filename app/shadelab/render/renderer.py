@@ -19,7 +19,7 @@ from shadelab.gl.vertex import soup_vertex_array, triangle_soup
 from shadelab.render.painter import draw_painter
 from shadelab.render.textures import TextureCache, has_surface_detail
 from shadelab.render.transparency import draw_transparent
-from shadelab.scene.camera import far_plane, gl_matrix, projection_matrix, view_matrix
+from shadelab.scene.camera import clip_from_world, far_plane, gl_matrix
 from shadelab.scene.model import MAX_LIGHTS, Light, Material, Scene
 from shadelab.shading.codes import ATTENUATION_CODES, LIGHT_KIND_CODES, SPECULAR_CODES
 from shadelab.shading.lights import pack_lights
@@ -48,7 +48,7 @@ class GpuMesh:
 
 @dataclass
 class View:
-    """Camera matrices for one frame (pyrr row-vector layout)."""
+    """Camera matrices for one frame (column vectors: ``p_clip = clip_from_world @ p_world``)."""
 
     clip_from_world: np.ndarray
     eye: np.ndarray
@@ -65,8 +65,8 @@ def make_view(scene: Scene, size: tuple[int, int], meshes: list[MeshData],
     if bounds is None:
         bounds = scene_bounds(meshes)
     far = math.inf if infinite_far else far_plane(scene.camera, bounds)
-    clip_from_world = view_matrix(scene.camera) @ projection_matrix(scene.camera, aspect, far)
-    return View(clip_from_world, np.asarray(scene.camera.eye, dtype=np.float64), size)
+    eye = np.asarray(scene.camera.eye, dtype=np.float64)
+    return View(clip_from_world(scene.camera, aspect, far), eye, size)
 
 
 class Renderer:
