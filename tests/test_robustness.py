@@ -483,3 +483,134 @@ def test_closed_stdout_exits_quietly():
     proc.stdout.close()  # the reader is gone before the first line
     assert proc.wait(timeout=60) == 0
     assert proc.stderr.read() == b""
+
+
+# ---------------------------------------------------------------- 7. process hygiene
+
+
+def _alive(pid: int) -> bool:
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().split(")")[-1].split()[0] != "Z"
+    except FileNotFoundError:
+        return False
+
+
+def _gone_within(pids: list[int], seconds: float) -> bool:
+    import time
+
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        if not any(_alive(p) for p in pids):
+            return True
+        time.sleep(0.05)
+    return not any(_alive(p) for p in pids)
+
+
+def _children(pid: int) -> list[int]:
+    out = subprocess.run(["ps", "-o", "pid=", "--ppid", str(pid)], capture_output=True,
+                         text=True)
+    return [int(p) for p in out.stdout.split()]
+
+
+VIEWER_STANDIN = '''
+import os, sys, time
+from shadelab.ui.jobs import WorkerProcess
+import slowjob
+w = WorkerProcess()
+w.ensure()
+w.tasks.put((1, slowjob.forever, None, (4, 4)))
+assert w.results.get(timeout=60)[0] == "progress"   # the job is running in the worker
+print(w.process.pid, flush=True)
+if sys.argv[1] == "exit":
+    w.shutdown()
+    print("done", flush=True)
+else:
+    time.sleep(120)
+'''
+
+SLOWJOB = '''
+import time
+from shadelab.progress import Progress
+
+def forever(scene, size):
+    while True:
+        yield Progress(None, 0.0, "busy", {"pad": "x" * 100000})  # fills the result pipe
+        time.sleep(0.01)
+'''
+
+
+@pytest.mark.parametrize("how", ["exit", "SIGTERM", "SIGKILL"])
+def test_offline_worker_never_outlives_the_viewer(tmp_path, how):
+    import os
+    import signal
+
+    (tmp_path / "slowjob.py").write_text(SLOWJOB)
+    env = {**os.environ, "PYTHONPATH": str(tmp_path)}
+    proc = subprocess.Popen([sys.executable, "-c", VIEWER_STANDIN, how], env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    worker = int(proc.stdout.readline())
+    assert _alive(worker)
+    if how != "exit":
+        proc.send_signal(getattr(signal, how))
+    proc.wait(timeout=30)
+    assert _gone_within([worker], 2.0), f"worker {worker} outlived the viewer ({how})"
+
+
+RAYTRACE_STANDIN = '''
+import sys, time
+from shadelab.cli import main
+sys.exit(main(sys.argv[1:]))
+'''
+
+
+@pytest.mark.parametrize("how", ["SIGTERM", "SIGKILL"])
+def test_raytrace_workers_never_outlive_the_main_process(tmp_path, how):
+    import signal
+    import time
+
+    preset = _preset(tmp_path, GOOD)
+    proc = subprocess.Popen([sys.executable, "-m", "shadelab", "raytrace", preset, "-o",
+                             str(tmp_path / "x.png"), "--size", "1024x1024", "--spp", "64",
+                             "--workers", "2", "--allow-large"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    kids: list[int] = []
+    while time.monotonic() < deadline and len(kids) < 3:  # 2 workers + resource tracker
+        time.sleep(0.5)
+        kids = _children(proc.pid)
+    assert len(kids) >= 2, kids
+    time.sleep(2)
+    proc.send_signal(getattr(signal, how))
+    proc.wait(timeout=30)
+    assert _gone_within(kids, 2.5), f"left running after {how}: {kids}"
+    assert not (tmp_path / "x.png").exists()
+
+
+@pytest.mark.parametrize("args, expected", [
+    (["--job", "nonsense"], "--job 'nonsense': expected one of reference, whitted, path"),
+    (["--job", ""], "--job '': expected one of"),
+    (["--screenshot", "x.exr"], "--screenshot 'x.exr': expected a file name ending in .png"),
+    (["--screenshot", "shot"], "expected a file name ending in .png"),
+])
+def test_viewer_flags_are_checked_before_any_window(tmp_path, capsys, monkeypatch, args,
+                                                    expected):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("DISPLAY", ":99")  # never reached: no window is tried
+    assert expected in one_error(capsys, ["view", "--fresh", "--no-autosave", *args])
+
+
+@pytest.mark.parametrize("display", [None, ":97"])
+def test_no_display_is_one_line(tmp_path, display):
+    import os
+
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    if display:
+        env["DISPLAY"] = display  # a server that is not there
+    out = subprocess.run([sys.executable, "-m", "shadelab", "view", "--fresh", "--no-autosave",
+                          "--frames", "1"], env=env, capture_output=True, text=True,
+                         timeout=120, cwd=tmp_path)
+    assert out.returncode == 2, out.stderr
+    assert out.stderr.count("\n") == 1 and "Traceback" not in out.stderr
+    assert "no display" in out.stderr and "xvfb-run" in out.stderr
+    assert "shadelab render" in out.stderr

@@ -11,7 +11,9 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import signal
 import sys
+import threading
 
 from shadelab.errors import ShadeLabError
 from shadelab.limits import ALLOW_ENV
@@ -46,6 +48,15 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+class _Terminated(BaseException):
+    """SIGTERM, raised in the main thread so that cleanup runs."""
+
+
+def _terminated(signum, frame):
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)  # a second SIGTERM ends it outright
+    raise _Terminated
+
+
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     parser = build_parser()
@@ -53,10 +64,15 @@ def main(argv: list[str] | None = None) -> int:
     if not argv or (argv[0] not in commands and argv[0] not in ("-h", "--help")):
         argv = ["view", *argv]  # 'shadelab [PRESET] [view options]' opens the viewer
     saved_allow = os.environ.get(ALLOW_ENV)
+    saved_term = None
     try:
         args = parser.parse_args(argv)
         if getattr(args, "allow_large", False):
             os.environ[ALLOW_ENV] = "1"  # seen by every check, and by worker processes
+        if args.command != "view" and threading.current_thread() is threading.main_thread():
+            # SIGTERM ends a batch job as Ctrl+C does: finally blocks run (worker processes
+            # are ended, temporary outputs removed), exit code 128 + 15
+            saved_term = signal.signal(signal.SIGTERM, _terminated)
         return int(args.run(args) or 0)
     except ShadeLabError as exc:
         print(f"shadelab: error: {exc}", file=sys.stderr)
@@ -64,6 +80,9 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("shadelab: interrupted", file=sys.stderr)
         return 130
+    except _Terminated:
+        print("shadelab: terminated", file=sys.stderr)
+        return 143
     except BrokenPipeError:  # 'shadelab presets | head -1': the reader has what it wanted
         try:
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no flush error
@@ -71,6 +90,8 @@ def main(argv: list[str] | None = None) -> int:
             pass
         return 0
     finally:
+        if saved_term is not None:
+            signal.signal(signal.SIGTERM, saved_term)
         if saved_allow is None:
             os.environ.pop(ALLOW_ENV, None)
         else:

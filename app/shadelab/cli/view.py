@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import argparse
 import os
+from pathlib import Path
 
 from shadelab.errors import ShadeLabError
 
 DEFAULT_PRESET = "lecture"
-NO_DISPLAY = ("no display (DISPLAY and WAYLAND_DISPLAY are unset): use 'shadelab render PRESET "
-              "-o OUT.png' for images without a window, or install Xvfb and run "
-              "'xvfb-run -a shadelab'")
+NO_DISPLAY = ("no display (DISPLAY and WAYLAND_DISPLAY are unset): run under xvfb-run "
+              "(install Xvfb; 'xvfb-run -a shadelab'), or use 'shadelab render PRESET -o "
+              "OUT.png'")
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -50,6 +51,35 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--no-autosave", action="store_true", help="do not write the session")
     p.add_argument("--bench-json", help=argparse.SUPPRESS)
     p.set_defaults(run=run_view)
+
+
+def check_display() -> None:
+    """One line, before any window code, when no display can be opened (unset, or naming a
+    server that is not there): GLFW's own failure ends in an ImGui assertion."""
+    if not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
+        raise ShadeLabError(NO_DISPLAY)
+    import glfw
+
+    glfw.ERROR_REPORTING = "ignore"
+    try:
+        ok = glfw.init()
+    except Exception:  # noqa: BLE001 - any failure of the probe means no usable display
+        ok = False
+    if not ok:
+        where = os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
+        raise ShadeLabError(f"no display: cannot open '{where}'; run under xvfb-run, or use "
+                            "shadelab render")
+    glfw.terminate()
+
+
+def check_job(name: str) -> None:
+    """--job names an offline renderer (a prefix of its label), checked before the window."""
+    from shadelab.ui.jobs import available_jobs
+
+    labels = [kind.label for kind in available_jobs()]
+    if not name.strip() or not any(label.lower().startswith(name.lower()) for label in labels):
+        raise ShadeLabError(f"--job '{name}': expected one of reference, whitted, path, "
+                            f"radiosity (a prefix of: {'; '.join(labels)})")
 
 
 def _pixel(text: str, flag: str) -> tuple[int, int]:
@@ -95,12 +125,15 @@ def load_scene(args: argparse.Namespace):
 
 
 def run_view(args: argparse.Namespace) -> int:
-    if not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
-        raise ShadeLabError(NO_DISPLAY)
     from shadelab.imageio import check_writable, parse_size
 
     window = parse_size(args.window)
     check_writable(args.screenshot, "--screenshot")
+    if args.screenshot and Path(args.screenshot).suffix.lower() != ".png":
+        raise ShadeLabError(f"--screenshot '{args.screenshot}': expected a file name ending "
+                            "in .png")
+    if args.job is not None:
+        check_job(args.job)
     probe = _pixel(args.probe, "--probe") if args.probe else None
     ray_tree = _pixel(args.ray_tree, "--ray-tree") if args.ray_tree else None
     if args.frames < 0:
@@ -116,6 +149,7 @@ def run_view(args: argparse.Namespace) -> int:
     from shadelab.geometry.mesh import scene_meshes
 
     scene_meshes(scene)  # a broken mesh file fails here, with its one-line reason
+    check_display()  # after the input: a bad flag or preset is named even without a display
     from shadelab.ui.app import ViewerOptions, run_viewer
     from shadelab.ui.state import AppState
 

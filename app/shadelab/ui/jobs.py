@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import importlib
 import multiprocessing
+import os
 import pickle
 import queue
 import sys
@@ -49,11 +50,18 @@ def _picklable(step: Progress) -> Progress:
         return Progress(step.image, step.fraction, step.message, stats)
 
 
-def _process_main(tasks, results, cancel) -> None:
-    """The worker process: run each (job_id, factory, scene, size) task, streaming Progress."""
+def _process_main(tasks, results, cancel, parent: int | None = None,
+                  deathsig: bool = False) -> None:
+    """The worker process: run each (job_id, factory, scene, size) task, streaming Progress.
+    It ends as soon as the viewer is gone (exited, terminated or killed; see
+    :func:`shadelab.raytrace.pool.die_with_parent`), even in the middle of a job."""
     import os
 
-    parent = os.getppid()
+    from shadelab.raytrace.pool import die_with_parent
+
+    parent = os.getppid() if parent is None else parent
+    die_with_parent(parent, deathsig)
+    results.cancel_join_thread()  # exiting never waits for a reader that is gone
     while True:
         try:
             task = tasks.get(timeout=1.0)
@@ -94,7 +102,9 @@ class WorkerProcess:
         self.tasks, self.results = self._mp.Queue(), self._mp.Queue()
         self.cancel = self._mp.Event()
         self.process = self._mp.Process(target=_process_main, name="shadelab-jobs", daemon=True,
-                                        args=(self.tasks, self.results, self.cancel))
+                                        args=(self.tasks, self.results, self.cancel,
+                                              os.getpid(), threading.current_thread()
+                                              is threading.main_thread()))
         # A spawned child re-imports the parent's __main__ (here ``shadelab/__main__.py``, which
         # would start another viewer); hide it while the child's start-up data is taken.
         main = sys.modules.get("__main__")
@@ -114,13 +124,19 @@ class WorkerProcess:
     def kill(self) -> None:
         if self.process is not None and self.process.is_alive():
             self.process.terminate()
-            self.process.join(2.0)
+            self.process.join(1.0)
+            if self.process.is_alive():  # SIGTERM not taken within a second: SIGKILL
+                self.process.kill()
+                self.process.join(0.5)
         self.process = None
 
     def shutdown(self) -> None:
+        """End the worker within ~2 s: ask (cancel the job, then the end-of-tasks mark),
+        then terminate, then kill."""
         if self.process is not None and self.process.is_alive():
+            self.cancel.set()
             self.tasks.put(None)
-            self.process.join(1.0)
+            self.process.join(0.5)
         self.kill()
 
 
