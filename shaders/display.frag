@@ -5,6 +5,8 @@ uniform sampler2D t_other;      // second image for the difference heat map
 uniform int u_mode;             // 0: tone map t_image, 1: heat map of |t_image - t_other|
 uniform float u_exposure;       // scale applied before display
 uniform float u_diff_scale;     // heat map: this difference (after exposure) is full red
+uniform int u_tonemap;          // 0: clamp to [0, 1], 1: Reinhard x / (1 + x)
+uniform int u_clipping;         // 1: stripe the pixels clamping cuts (a channel above 1)
 
 in vec2 v_uv;
 out vec4 f_color;
@@ -32,6 +34,13 @@ void main() {
         vec3 d = abs(a - b);
         f_color = vec4(heat(max(d.r, max(d.g, d.b)) / max(u_diff_scale, 1e-12)), 1.0);
     } else {
-        f_color = vec4(to_srgb(a), 1.0);
+        vec3 mapped = u_tonemap == 1 ? a / (1.0 + a) : a;
+        vec3 rgb = to_srgb(mapped);
+        if (u_clipping == 1 && u_tonemap == 0 && max(a.r, max(a.g, a.b)) > 1.0) {
+            // magenta / black diagonal stripes, 8 pixels apart: readable from the back row
+            float stripe = mod(floor((gl_FragCoord.x + gl_FragCoord.y) / 4.0), 2.0);
+            rgb = stripe < 1.0 ? vec3(1.0, 0.0, 1.0) : vec3(0.0);
+        }
+        f_color = vec4(rgb, 1.0);
     }
 }

@@ -277,7 +277,10 @@ def scenario_save_reload(ctx, state, out: dict) -> None:
     state.mark_edited()
     ctx.yield_(2)
     ctx.item_click("Open file")
+    ctx.yield_(2)  # unsaved edits: the viewer asks first
+    ctx.item_click("//Discard unsaved changes?/Open (discard)")
     ctx.yield_(2)
+    ctx.set_ref("//Scene")
     out["reloaded_kd"] = state.scene.materials["white"].kd
     bad = Path(OUT_DIR) / "bad.toml"
     bad.write_text("schema_version = 1\n[materials.white]\nkd = 'lots'\n")

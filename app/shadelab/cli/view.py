@@ -7,8 +7,10 @@ import os
 from pathlib import Path
 
 from shadelab.errors import ShadeLabError
+from shadelab.scene.preset import scene_to_dict
 
 DEFAULT_PRESET = "lecture"
+DEFAULT_WINDOW = "1600x900"  # the window's size before it is maximized
 NO_DISPLAY = ("no display (DISPLAY and WAYLAND_DISPLAY are unset): run under xvfb-run "
               "(install Xvfb; 'xvfb-run -a shadelab'), or use 'shadelab render PRESET -o "
               "OUT.png'")
@@ -22,7 +24,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="override a preset value, e.g. materials.white.kd=0.5")
     p.add_argument("--fresh", action="store_true", help="ignore the autosaved session")
-    p.add_argument("--window", default="1600x900", metavar="WxH", help="window size")
+    p.add_argument("--window", default=None, metavar="WxH",
+                   help="window size (default: maximized on the monitor)")
+    p.add_argument("--fullscreen", action="store_true",
+                   help="fullscreen at the monitor's resolution (F11 toggles)")
+    p.add_argument("--lesson", metavar="NAME", help="walk a lesson from presets/lessons/ "
+                   "(PageDown / PageUp), e.g. phong-to-radiosity")
     p.add_argument("--frames", type=int, default=0, metavar="N", help="quit after N frames")
     p.add_argument("--screenshot", metavar="PATH", help="write a PNG of the window at exit")
     p.add_argument("--compare", action="store_true", help="start in 2x2 compare mode")
@@ -109,6 +116,16 @@ def _check_study_and_case(args: argparse.Namespace) -> None:
                                 f"{', '.join(names)}")
 
 
+def saved_of(source: str) -> dict:
+    """The preset a restored session came from, as saved (empty when it no longer loads)."""
+    from shadelab.scene.preset import load_preset
+
+    try:
+        return scene_to_dict(load_preset(source))
+    except ShadeLabError:
+        return {}
+
+
 def load_scene(args: argparse.Namespace):
     """(scene, source, restored): the autosaved session if it matches, else the preset."""
     from shadelab.scene.preset import load_preset
@@ -127,7 +144,7 @@ def load_scene(args: argparse.Namespace):
 def run_view(args: argparse.Namespace) -> int:
     from shadelab.imageio import check_writable, parse_size
 
-    window = parse_size(args.window)
+    window = parse_size(args.window or DEFAULT_WINDOW)
     check_writable(args.screenshot, "--screenshot")
     if args.screenshot and Path(args.screenshot).suffix.lower() != ".png":
         raise ShadeLabError(f"--screenshot '{args.screenshot}': expected a file name ending "
@@ -145,7 +162,15 @@ def run_view(args: argparse.Namespace) -> int:
         if args.pipeline not in PIPELINE_NAMES:
             raise ShadeLabError(f"--pipeline '{args.pipeline}': expected one of "
                                 f"{', '.join(PIPELINE_NAMES)}")
-    scene, source, restored = load_scene(args)
+    run = None
+    if args.lesson:
+        from shadelab.ui.lesson import LessonRun, load_lesson, step_scene
+
+        run = LessonRun(load_lesson(args.lesson))  # every step checked: one-line error
+        scene, source, restored = step_scene(run.lesson.steps[0]), \
+            run.lesson.steps[0].preset, False
+    else:
+        scene, source, restored = load_scene(args)
     from shadelab.geometry.mesh import scene_meshes
 
     scene_meshes(scene)  # a broken mesh file fails here, with its one-line reason
@@ -156,6 +181,14 @@ def run_view(args: argparse.Namespace) -> int:
     state = AppState.from_scene(scene, source)
     if restored:
         state.status = f"restored the autosaved session of '{source}'"
+        state.saved = saved_of(source)  # the unsaved marker compares with the file, not
+        state.dirty = state.saved != scene_to_dict(scene)  # with the restored session
+        state.history.files[0] = state.file_meta()
+    if run is not None:
+        from shadelab.ui.lesson import go_to
+
+        state.lesson = run
+        go_to(state, 0)
     state.compare, state.diff_enabled = args.compare, args.diff
     state.presenter, state.show_help = args.presenter, args.help_overlay
     state.show_wireframe, state.show_normals = args.wireframe, args.normals
@@ -164,5 +197,7 @@ def run_view(args: argparse.Namespace) -> int:
                             bench_json=args.bench_json or "", autosave=not args.no_autosave,
                             show_radiosity=args.show_radiosity, ray_tree=ray_tree,
                             focus=args.focus or "", study=args.study or "",
-                            gallery=args.gallery or "", pipeline=args.pipeline or "")
+                            gallery=args.gallery or "", pipeline=args.pipeline or "",
+                            fullscreen=args.fullscreen,
+                            maximized=args.window is None and not args.fullscreen)
     return run_viewer(state, options)

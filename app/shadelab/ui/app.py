@@ -20,7 +20,7 @@ from imgui_bundle import hello_imgui, imgui, immapp
 
 from shadelab.geometry.mesh import geometry_key, scene_meshes
 from shadelab.scene.model import Camera
-from shadelab.ui import overlays, panels, pipelines
+from shadelab.ui import gizmos, lesson, overlays, panels, pipelines, presenter
 from shadelab.ui.frame import guarded
 from shadelab.ui.offline import draw_offline_panel
 from shadelab.ui.probe import probe
@@ -59,6 +59,8 @@ class ViewerOptions:
     focus: str = ""                       # dock windows brought to front at start (a,b,...)
     study: str = ""                       # study run (quick) at start; --frames counts after it
     gallery: str = ""                     # failure-gallery case selected and opened at start
+    fullscreen: bool = False              # open fullscreen at the monitor's resolution
+    maximized: bool = False               # open maximized (no --window given)
     pipeline: str = ""                    # viewport pipeline at start (shadelab.ui.pipelines)
     test_function: Callable | None = None  # immapp.testing test body (GUI tests)
 
@@ -161,6 +163,10 @@ SHORTCUTS = (
     (K.f, "F", "presenter mode (large fonts)", _toggle("presenter")),
     (K.h, "H", "this help", _toggle("show_help")),
     (K.f1, "F1", "this help", _toggle("show_help")),
+    (K.tab, "Tab", "viewport only (hide every panel)", presenter.toggle_panels),
+    (K.f11, "F11", "fullscreen", presenter.toggle_fullscreen),
+    (K.page_down, "PgDn", "next lesson step", lesson.next_step),
+    (K.page_up, "PgUp", "previous lesson step", lesson.previous_step),
     (CTRL | K.z, "Ctrl+Z", "undo", AppState.undo),
     (CTRL | K.y, "Ctrl+Y", "redo", AppState.redo),
     (CTRL | K.s, "Ctrl+S", "save the preset", _save),
@@ -225,6 +231,9 @@ class Viewer:
 
         self.viewport = Viewport(attach_to_current())
         self.state.gl = self.viewport
+        from shadelab.ui.dialogs import install_drop_callback
+
+        install_drop_callback()
         if self.options.probe is not None:
             self.state.probe_pixel, self.state.probe_requested = self.options.probe, True
         if self.options.focus:
@@ -271,6 +280,7 @@ class Viewer:
     # ------------------------------------------------------------ viewport window
     def draw_viewport_window(self) -> None:
         state = self.state
+        origin = imgui.get_cursor_screen_pos()
         avail = imgui.get_content_region_avail()
         size = (max(int(avail.x), 16), max(int(avail.y) - 4, 16))
         if size != state.viewport_size and state.probe_pixel is not None:
@@ -280,6 +290,9 @@ class Viewer:
             self.draw_compare(size)
         else:
             self.draw_main(size)
+        if not state.compare:
+            gizmos.draw(state, origin, size)
+        presenter.draw_viewport_extras(state, origin, size, self.redrawn)
         if state.error:
             imgui.set_cursor_pos(imgui.ImVec2(12, 40))
             imgui.text_colored(panels.ERROR_COLOR, f"Error: {state.error}")
@@ -302,7 +315,7 @@ class Viewer:
         if imgui.is_item_active():
             dx, dy = io.mouse_delta.x, io.mouse_delta.y
             self.drag += abs(dx) + abs(dy)
-            if self.drag > CLICK_SLOP and (dx or dy):
+            if self.drag > CLICK_SLOP and (dx or dy) and not gizmos.capturing():
                 if imgui.is_mouse_down(imgui.MouseButton_.left):
                     orbit(camera, dx, dy, size[1])
                 else:
@@ -323,7 +336,7 @@ class Viewer:
         probe_id = s.probe_version
         return (repr(s.scene), size, s.compare, s.diff_enabled, s.diff_pair, s.diff_scale,
                 s.show_wireframe, s.show_normals, s.normal_length, probe_id, s.overlay_version,
-                s.show_radiosity)
+                s.show_radiosity, s.tonemap, s.show_clipping, presenter.line_px(s), s.antialias)
 
     def unchanged(self, size: tuple[int, int]) -> bool:
         """True when the last image is still right (idle frames only redraw the GUI)."""
@@ -358,6 +371,7 @@ class Viewer:
         # --- PASS 4: overlays (wireframe, normal glyphs, probe arrows)
         exposure = scene.render.exposure
         meshes = scene_meshes(scene)
+        vp.line_width = presenter.line_px(state) * size[0] / max(display_size[0], 1)
         if state.show_wireframe:
             vp.draw_lines(pane, self.cached_lines("wire", meshes), exposure)
         if state.show_normals:
@@ -369,8 +383,8 @@ class Viewer:
         if state.ray_tree is not None:
             lines = overlays.ray_tree_lines(state.ray_tree, overlays.scene_diagonal(meshes))
             vp.draw_lines(pane, lines, exposure, depth_test=False)
-        # --- PASS 5: exposure + sRGB for display
-        texture = vp.present(pane, exposure)
+        # --- PASS 5: exposure, tone map + sRGB for display
+        texture = vp.present(pane, exposure, tonemap=state.tonemap, clipping=state.show_clipping)
         if state.screenshot_requested:
             self.write_viewport_screenshot(state.screenshot_requested)
             state.screenshot_requested = ""
@@ -385,6 +399,7 @@ class Viewer:
         scale = self.state.render_scale
         if self.interacting():
             scale = min(scale, self.state.interactive_scale)
+        scale *= self.state.antialias  # supersampled, filtered down by the display texture
         return max(int(size[0] * scale), 8), max(int(size[1] * scale), 8)
 
     def _handle_click(self, clicked, size: tuple[int, int]) -> None:
@@ -471,7 +486,7 @@ class Viewer:
             return
         origin = imgui.get_cursor_screen_pos()
         for pane in panes:
-            vp.present(pane, exposure)
+            vp.present(pane, exposure, tonemap=state.tonemap, clipping=state.show_clipping)
         draw = imgui.get_window_draw_list()
         for i, pane in enumerate(panes):
             x = origin.x + (i % 2) * half[0]
@@ -532,12 +547,13 @@ class Viewer:
         """Shortcuts, undo snapshots, autosave, title, scripted exit."""
         state = self.state
         handle_shortcuts(state)
+        presenter.end_frame(self)
         draw_help_overlay(state)
         scale = PRESENTER_SCALE if state.presenter else 1.0
         style = imgui.get_style()
         if style.font_scale_main != scale:  # only on change: a new scale re-bakes glyphs
             style.font_scale_main = scale
-        if state.edit_pending and not imgui.is_any_item_active():
+        if state.edit_pending and not imgui.is_any_item_active() and not gizmos.capturing():
             state.commit_edit()
         if self.options.autosave:
             self.autosave()
@@ -719,6 +735,7 @@ def _scene_panel(state: AppState) -> bool:
     _, state.render_scale = panels._slider("render scale", state.render_scale, 0.25, 1.0)
     _, state.interactive_scale = panels._slider("while dragging", state.interactive_scale,
                                                 0.25, 1.0)
+    presenter.draw_display_panel(state)
     return edited
 
 
@@ -726,6 +743,13 @@ def runner_params(viewer: Viewer) -> hello_imgui.RunnerParams:
     params = hello_imgui.RunnerParams()
     params.app_window_params.window_title = viewer.state.title()
     params.app_window_params.window_geometry.size = viewer.options.window_size
+    if viewer.options.fullscreen:
+        params.app_window_params.window_geometry.full_screen_mode = \
+            hello_imgui.FullScreenMode.full_monitor_resolution
+        viewer.state.fullscreen = True
+        presenter.mark_fullscreen_applied()
+    elif viewer.options.maximized:
+        params.app_window_params.window_size_state = hello_imgui.WindowSizeState.maximized
     params.imgui_window_params.default_imgui_window_type = \
         hello_imgui.DefaultImGuiWindowType.provide_full_screen_dock_space
     params.imgui_window_params.enable_viewports = False
@@ -738,7 +762,7 @@ def runner_params(viewer: Viewer) -> hello_imgui.RunnerParams:
                                            or viewer.options.frames)
     params.callbacks.post_init = viewer.post_init
     params.callbacks.before_exit = viewer.before_exit
-    params.callbacks.post_new_frame = lambda: None
+    params.callbacks.post_new_frame = gizmos.begin_frame
     params.callbacks.show_gui = lambda: guarded(viewer.end_frame, "frame", viewer.report_error)
     return params
 

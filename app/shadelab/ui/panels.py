@@ -22,6 +22,8 @@ from shadelab.scene.model import (
 )
 from shadelab.scene.preset import list_presets
 from shadelab.shading import reference
+from shadelab.ui import dialogs
+from shadelab.ui.presenter import same_line_if_fits
 from shadelab.ui.ranges import field_slider, intensity_range
 from shadelab.ui.state import COMPARE_LABELS, AppState
 
@@ -108,17 +110,25 @@ def draw_file_panel(state: AppState) -> bool:
     if imgui.begin_combo("Preset", current or "(file)"):
         for name in presets:
             if imgui.selectable(name, name == current)[0]:
-                state.open_preset(name)
+                state.request_open(name)  # asks first when there are unsaved edits
         imgui.end_combo()
     _, state.open_path = imgui.input_text("File", state.open_path)
     if imgui.button("Open file"):
-        state.open_file(state.open_path)  # a preset replaces the scene; a mesh is added
-    imgui.same_line()
+        state.request_open(state.open_path)  # a preset replaces the scene; a mesh is added
+    if same_line_if_fits("Save as"):
+        imgui.same_line()
     if imgui.button("Save as"):
         state.save_as(state.open_path)
-    imgui.same_line()
+    if same_line_if_fits("Save"):
+        imgui.same_line()
     if imgui.button("Save") and (state.preset_path or state.open_path):
         state.save_as(state.preset_path or state.open_path)
+    for label, purpose in (("Open...", "open"), ("Save as...", "save"),
+                           ("Add mesh...", "mesh")):  # native dialogs
+        if purpose != "open" and same_line_if_fits(label):
+            imgui.same_line()
+        if imgui.button(label):
+            dialogs.ask(state, purpose)
     imgui.begin_disabled(not state.history.can_undo())
     if imgui.button("Undo (Ctrl+Z)"):
         state.undo()
@@ -141,12 +151,14 @@ def draw_render_panel(state: AppState) -> bool:
     draw_pipeline_selector(state)
     imgui.text("Shading")
     for mode in SHADING_MODES:
-        imgui.same_line()
+        if same_line_if_fits(SHADING_LABELS[mode], radio=True):
+            imgui.same_line()
         if imgui.radio_button(SHADING_LABELS[mode], scene.render.shading == mode):
             scene.render.shading, edited = mode, True
     imgui.text("Specular")
     for model in SPECULAR_MODELS:
-        imgui.same_line()
+        if same_line_if_fits(SPECULAR_LABELS[model], radio=True):
+            imgui.same_line()
         if imgui.radio_button(SPECULAR_LABELS[model], scene.render.specular == model):
             scene.render.specular, edited = model, True
     edited |= _edit_fields(scene.render, [("exposure", field_slider(RenderSettings))])
@@ -216,6 +228,9 @@ def _draw_attenuation_plot(state: AppState, index: int, light: Light) -> None:
 def draw_lights_panel(state: AppState) -> bool:
     """Every light: kind, placement, Ip, cone, attenuation with its f_att(d) curve."""
     scene, edited, span = state.scene, False, scene_span(state)
+    from shadelab.ui.gizmos import draw_selector
+
+    draw_selector(state)  # which light the viewport's gizmo drags
     remove = None
     for i, light in enumerate(scene.lights):
         imgui.push_id(f"light{i}")
@@ -334,7 +349,7 @@ def draw_equation_panel(state: AppState) -> bool:
     imgui.text_wrapped(EQUATION_BLINN if blinn else EQUATION)
     imgui.text_wrapped("f_att = min(1 / (c1 + c2 d + c3 d^2), 1);  "
                        + ("H = (L + V) / |L + V|" if blinn else "R = 2 N (N.L) - L"))
-    imgui.text(f"Ia = {_rgb(scene.Ia)}   shading: {SHADING_LABELS[scene.render.shading]}")
+    imgui.text_wrapped(f"Ia = {_rgb(scene.Ia)}   shading: {SHADING_LABELS[scene.render.shading]}")
     result = state.probe
     if result is None:
         imgui.separator()
@@ -344,15 +359,17 @@ def draw_equation_panel(state: AppState) -> bool:
         return False
     m = scene.materials[result.hit.mesh.material]
     imgui.separator()
-    imgui.text(f"pixel {result.pixel}  object {result.hit.mesh.index} "
+    imgui.text_wrapped(f"pixel {result.pixel}  object {result.hit.mesh.index} "
                f"({scene.objects[result.hit.mesh.index].name or 'unnamed'}), material "
                f"'{result.hit.mesh.material}'")
-    imgui.text(f"P = {_rgb(result.point, 4)}  N = {_rgb(result.normal)}")
-    imgui.text(f"V = {_rgb(result.to_eye)}")
-    imgui.text(f"ka {m.ka:.3g}  kd {m.kd:.3g}  ks {m.ks:.3g}  n {m.n:.3g}  "
+    imgui.text_wrapped(f"P = {_rgb(result.point, 4)}  N = {_rgb(result.normal)}")
+    imgui.text_wrapped(f"V = {_rgb(result.to_eye)}")
+    imgui.text_wrapped(f"ka {m.ka:.3g}  kd {m.kd:.3g}  ks {m.ks:.3g}  n {m.n:.3g}  "
                f"Od {_rgb(m.Od)}  Os {_rgb(m.Os)}")
+    imgui.push_text_wrap_pos(0.0)
     imgui.text_colored(DIM_COLOR, "arrows: N white, V cyan, L_i yellow, "
                        + ("H_i" if blinn else "R_i") + " magenta")
+    imgui.pop_text_wrap_pos()
     lights = scene.active_lights()
     flags = (imgui.TableFlags_.borders | imgui.TableFlags_.row_bg
              | imgui.TableFlags_.sizing_fixed_fit)
@@ -382,16 +399,19 @@ def draw_equation_panel(state: AppState) -> bool:
     for i, t in enumerate(result.terms.lights[:len(lights)]):
         name = lights[i].name or f"light {i}"
         if lights[i].attenuation == "lecture":
-            imgui.text(f"{name}: min(1/(c1 + c2 d + c3 d^2), 1) clamp "
+            imgui.text_wrapped(f"{name}: min(1/(c1 + c2 d + c3 d^2), 1) clamp "
                        + ("ACTIVE (f_att = 1)" if bool(t.clamp_active) else "not active"))
         else:
-            imgui.text(f"{name}: attenuation '{lights[i].attenuation}' (no min(., 1) clamp)")
+            imgui.text_wrapped(f"{name}: attenuation '{lights[i].attenuation}' "
+                               "(no min(., 1) clamp)")
     if result.gpu is not None:
         err = float(np.max(np.abs(result.gpu - result.reference)))
         agree = err <= 1e-4 * max(1.0, float(np.max(np.abs(result.reference))))
+        imgui.push_text_wrap_pos(0.0)
         imgui.text_colored(OK_COLOR if agree else ERROR_COLOR,
                            f"GPU vs numpy reference: max |diff| {err:.2g} "
                            + ("(agree)" if agree else "(DIFFER)"))
+        imgui.pop_text_wrap_pos()
     if result.shading != "phong":
         imgui.text_wrapped(f"{SHADING_LABELS[result.shading]} shading: the terms above are at "
                            "the probed point; the pixel's I is "

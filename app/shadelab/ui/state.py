@@ -22,21 +22,37 @@ HISTORY_LIMIT = 200          # undo snapshots kept
 AUTOSAVE_INTERVAL = 1.0      # seconds between autosaves of a changed scene
 
 
-class History:
-    """Undo/redo over Scene snapshots (one per finished edit, e.g. a slider release)."""
+def _without_camera(scene: Scene) -> dict:
+    d = scene_to_dict(scene)
+    d.pop("camera", None)
+    return d
 
-    def __init__(self, scene: Scene):
+
+class History:
+    """Undo/redo over Scene snapshots (one per finished edit, e.g. a slider release).
+
+    Camera moves are not on the stack (an orbit is no edit to undo); opening a preset is
+    (``file`` is what the title and "Save" need to go back to the file shown before)."""
+
+    def __init__(self, scene: Scene, file: dict | None = None):
         self.snapshots = [clone_scene(scene)]
+        self.files = [file]
         self.index = 0
 
-    def push(self, scene: Scene) -> None:
-        if scene_to_dict(scene) == scene_to_dict(self.snapshots[self.index]):
-            return  # nothing changed (e.g. a slider clicked but not moved)
+    def push(self, scene: Scene, file: dict | None = None) -> None:
+        if file is None and _without_camera(scene) == _without_camera(self.snapshots[self.index]):
+            return  # nothing changed (a slider clicked but not moved, or the camera only)
         del self.snapshots[self.index + 1:]
+        del self.files[self.index + 1:]
         self.snapshots.append(clone_scene(scene))
+        self.files.append(file if file is not None else self.files[self.index])
         if len(self.snapshots) > HISTORY_LIMIT:
             self.snapshots.pop(0)
+            self.files.pop(0)
         self.index = len(self.snapshots) - 1
+
+    def file(self) -> dict | None:
+        return self.files[self.index]
 
     def can_undo(self) -> bool:
         return self.index > 0
@@ -176,6 +192,20 @@ class AppState:
     study_budget: float = 0.01        # auto quality's error budget (relative MSE)
     gallery_index: int = -1           # selected case of shadelab.studies.gallery.GALLERY
     gallery_opened: str = ""          # name of the last case opened in the viewer
+    # Presenter (shadelab.ui.presenter), lessons (shadelab.ui.lesson), dialogs
+    hide_panels: bool = False         # Tab: the viewport alone, with a caption
+    fullscreen: bool = False          # F11 / --fullscreen: the monitor's resolution
+    tonemap: str = "clamp"            # display: clamp | reinhard
+    show_clipping: bool = False       # display: paint clipped pixels
+    show_fps: bool = True             # fps / frame-time readout in the viewport
+    antialias: int = 1                # supersampling factor of the scene pass (1 or 2)
+    line_width: float = 0.0           # overlay lines, pixels (0: by the presenter scale)
+    lesson: Any = None                # shadelab.ui.lesson.LessonRun
+    pending_open: str = ""            # a file asked for while there are unsaved edits
+    scene_version: int = 0            # bumped by every scene edit and load
+    show_gizmos: bool = True          # light gizmos in the viewport
+    focus_request: str = ""           # panels to bring to the front next frame (a,b,...)
+    gizmo_light: int = 0              # the light the viewport gizmo moves
 
     @classmethod
     def from_scene(cls, scene: Scene, source: str, **kwargs) -> "AppState":
@@ -184,13 +214,19 @@ class AppState:
         state = cls(scene=scene, source=source, **kwargs)
         state.saved = scene_to_dict(scene)
         state.initial_camera = clone_scene(scene).camera
-        state.history = History(scene)
+        state.history = History(scene, state.file_meta())
         state.job = JobRunner()
         return state
 
     # ------------------------------------------------------------ edits
+    def file_meta(self) -> dict:
+        """Where the scene came from (what undoing a preset load goes back to)."""
+        return {"source": self.source, "saved": self.saved, "preset_path": self.preset_path,
+                "initial_camera": self.initial_camera}
+
     def mark_edited(self) -> None:
         """A parameter changed this frame; it joins the undo history once the edit ends."""
+        self.scene_version += 1
         self.edit_pending = True
         self.autosave_due = True
         self.probe_requested = self.probe_pixel is not None
@@ -206,28 +242,46 @@ class AppState:
                       new_file: bool = False) -> None:
         """Show another scene (undo/redo keep the file; opening one resets everything)."""
         self.scene = scene
+        self.scene_version += 1
         if new_file:
             self.source = source or scene.name
             self.saved = scene_to_dict(scene)
             self.initial_camera = clone_scene(scene).camera
-            self.history = History(scene)
             self.probe_pixel, self.probe = None, None
             self.preset_path = ""
+            self.history.push(scene, self.file_meta())  # undo goes back to the last file
         self.dirty = scene_to_dict(scene) != self.saved
         self.autosave_due = True
         self.probe_requested = self.probe_pixel is not None
 
+    def _go_to_snapshot(self, scene: Scene | None, what: str) -> None:
+        if scene is None:
+            return
+        file = self.history.file()
+        if file is not None and file["source"] != self.source:
+            self.source, self.saved = file["source"], file["saved"]  # another file: its camera
+            self.preset_path, self.initial_camera = file["preset_path"], file["initial_camera"]
+            self.probe_pixel, self.probe = None, None
+        else:
+            scene.camera = self.scene.camera  # camera moves are not undone
+        self.replace_scene(scene)
+        self.status = what
+
     def undo(self) -> None:
-        scene = self.history.undo()
-        if scene is not None:
-            self.replace_scene(scene)
-            self.status = "undo"
+        self._go_to_snapshot(self.history.undo(), "undo")
 
     def redo(self) -> None:
-        scene = self.history.redo()
-        if scene is not None:
-            self.replace_scene(scene)
-            self.status = "redo"
+        self._go_to_snapshot(self.history.redo(), "redo")
+
+    def request_open(self, path: str) -> None:
+        """Open a preset or add a mesh; with unsaved edits, replacing the scene asks first
+        (``pending_open``, answered by :func:`shadelab.ui.dialogs.draw_discard_question`)."""
+        from shadelab.geometry.mesh import MESH_SUFFIXES
+
+        if self.dirty and Path(path).suffix.lower() not in MESH_SUFFIXES:
+            self.pending_open = path
+        else:
+            self.open_file(path)
 
     def open_file(self, path: str) -> bool:
         """A preset (.toml or a name) replaces the scene; a mesh file is added to it."""
@@ -300,8 +354,10 @@ class AppState:
         return True
 
     def reset_view(self) -> None:
+        import copy
+
         self.scene.camera = clone_scene(self.scene).camera if self.initial_camera is None \
-            else type(self.initial_camera)(**vars(self.initial_camera))
+            else copy.deepcopy(self.initial_camera)
         self.mark_edited()
 
     def title(self) -> str:

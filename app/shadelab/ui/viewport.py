@@ -54,6 +54,13 @@ class Viewport:
         self._line_buffer = ctx.buffer(reserve=1 << 20, dynamic=True)
         self._line_vao = ctx.vertex_array(self.lines_program,
                                           [(self._line_buffer, "3f 3f", "in_position", "in_color")])
+        self.line_width = 1.0  # overlay lines, pixels of the target (> 1: drawn as quads)
+        self.thick_program = load_program(ctx, "thick_lines")
+        self._thick_buffer = ctx.buffer(reserve=1 << 20, dynamic=True)
+        self._thick_vao = ctx.vertex_array(
+            self.thick_program,
+            [(self._thick_buffer, "3f 3f 3f 1f", "in_position", "in_other", "in_color",
+              "in_side")])
 
     def restore(self) -> None:
         """Bind the window's framebuffer again (imgui draws there), or a 1x1 anchor headless.
@@ -103,6 +110,9 @@ class Viewport:
         """Overlay colored segments (wireframe, glyphs, arrows) onto the float target."""
         if len(lines) == 0 or pane.view is None:
             return
+        if mode == moderngl.LINES and self.line_width > 1.0:
+            self._draw_thick(pane, lines, exposure, depth_test, bias)
+            return
         data = np.ascontiguousarray(lines, dtype=np.float32).tobytes()
         if len(data) > self._line_buffer.size:
             self._line_buffer.orphan(len(data) * 2)
@@ -115,10 +125,29 @@ class Viewport:
         set_uniform(program, "u_scale", 1.0 / max(exposure, 1e-12))
         self._line_vao.render(mode, vertices=len(lines))
 
+    def _draw_thick(self, pane: Pane, lines: np.ndarray, exposure: float, depth_test: bool,
+                    bias: float) -> None:
+        """Segments as quads ``self.line_width`` pixels wide (see shaders/thick_lines.vert)."""
+        data = np.ascontiguousarray(thick_line_vertices(lines), dtype=np.float32).tobytes()
+        if len(data) > self._thick_buffer.size:
+            self._thick_buffer.orphan(len(data) * 2)
+        self._thick_buffer.write(data)
+        pane.target.use()
+        self.ctx.enable_only(moderngl.DEPTH_TEST if depth_test else moderngl.NOTHING)
+        program = self.thick_program
+        set_uniform(program, "u_clip_from_world", gl_matrix(pane.view.clip_from_world))
+        set_uniform(program, "u_depth_bias", bias if depth_test else 0.0)
+        set_uniform(program, "u_scale", 1.0 / max(exposure, 1e-12))
+        set_uniform(program, "u_viewport", tuple(float(c) for c in pane.size))
+        set_uniform(program, "u_width", float(self.line_width))
+        self._thick_vao.render(moderngl.TRIANGLES, vertices=len(lines) // 2 * 6)
+
     def present(self, pane: Pane, exposure: float, source: Pane | None = None,
-                other: Pane | None = None, diff_scale: float = 0.05) -> moderngl.Texture:
-        """Display pass into ``pane``'s RGBA8 texture: exposure + sRGB of ``source`` (default
-        the pane itself), or the |source - other| heat map when ``other`` is given."""
+                other: Pane | None = None, diff_scale: float = 0.05, tonemap: str = "clamp",
+                clipping: bool = False) -> moderngl.Texture:
+        """Display pass into ``pane``'s RGBA8 texture: exposure, tone map (clamp | reinhard),
+        sRGB of ``source`` (default the pane itself), or the |source - other| heat map when
+        ``other`` is given; ``clipping`` stripes the pixels the clamp cuts."""
         source = source or pane
         pane.display_fbo.use()
         self.ctx.enable_only(moderngl.NOTHING)
@@ -130,6 +159,8 @@ class Viewport:
         set_uniform(program, "u_mode", 1 if other is not None else 0)
         set_uniform(program, "u_exposure", float(exposure))
         set_uniform(program, "u_diff_scale", float(diff_scale))
+        set_uniform(program, "u_tonemap", 1 if tonemap == "reinhard" else 0)
+        set_uniform(program, "u_clipping", 1 if clipping else 0)
         self.display_vao.render(moderngl.TRIANGLES, vertices=3)
         self.restore()
         return pane.display
@@ -178,9 +209,27 @@ class Viewport:
             tex.release()
         self._line_vao.release()
         self._line_buffer.release()
+        self._thick_vao.release()
+        self._thick_buffer.release()
+        self.thick_program.release()
         self.display_vao.release()
         self.display_program.release()
         self.lines_program.release()
         self.renderer.release()
         (self.ctx.screen or self.ctx.detect_framebuffer(0)).use()
         self._anchor.release()
+
+
+def thick_line_vertices(lines: np.ndarray) -> np.ndarray:
+    """(2N, 6) segment ends (position, color) -> (6N, 10) quad corners: position, other end,
+    color, side (+1 / -1), two triangles per segment."""
+    ends = np.asarray(lines, dtype=np.float32).reshape(-1, 2, 6)
+    p0, p1, c0, c1 = ends[:, 0, :3], ends[:, 1, :3], ends[:, 0, 3:], ends[:, 1, 3:]
+    n = len(ends)
+
+    def corner(p, q, c, side):
+        return np.concatenate([p, q, c, np.full((n, 1), side, np.float32)], axis=1)
+
+    a, b = corner(p0, p1, c0, 1.0), corner(p0, p1, c0, -1.0)
+    c, d = corner(p1, p0, c1, 1.0), corner(p1, p0, c1, -1.0)
+    return np.stack([a, b, c, a, c, d], axis=1).reshape(-1, 10)
