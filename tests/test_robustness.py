@@ -614,3 +614,45 @@ def test_no_display_is_one_line(tmp_path, display):
     assert out.stderr.count("\n") == 1 and "Traceback" not in out.stderr
     assert "no display" in out.stderr and "xvfb-run" in out.stderr
     assert "shadelab render" in out.stderr
+
+
+# ---------------------------------------------------------------- no code from content
+
+
+def test_no_code_path_evaluates_unpickles_or_fetches_content():
+    """Presets, sessions and meshes are data: nothing in the package evaluates, unpickles or
+    fetches anything (pickle.dumps for the job queue is fine: it only writes)."""
+    import ast
+
+    import shadelab
+
+    banned_calls = {"eval", "exec", "compile", "__import__"}
+    banned_attrs = {("pickle", "load"), ("pickle", "loads"), ("marshal", "load"),
+                    ("marshal", "loads"), ("yaml", "load"), ("yaml", "unsafe_load"),
+                    ("shelve", "open"), ("numpy", "load"), ("np", "load")}
+    banned_modules = {"urllib", "requests", "http", "httpx", "aiohttp", "socket", "ftplib",
+                      "dill", "cloudpickle", "shelve", "marshal"}
+    found = []
+    root = Path(shadelab.__file__).parent
+    for path in sorted(root.rglob("*.py")):
+        tree = ast.parse(path.read_text(encoding="utf-8"), str(path))
+        for node in ast.walk(tree):
+            where = f"{path.relative_to(root)}:{getattr(node, 'lineno', 0)}"
+            if isinstance(node, ast.Call):
+                f = node.func
+                if isinstance(f, ast.Name) and f.id in banned_calls:
+                    found.append(f"{where} {f.id}()")
+                if isinstance(f, ast.Attribute) and isinstance(f.value, ast.Name) and \
+                        (f.value.id, f.attr) in banned_attrs:
+                    allow = f.attr == "load" and f.value.id in ("np", "numpy") and any(
+                        isinstance(k, ast.keyword) and k.arg == "allow_pickle" and
+                        isinstance(k.value, ast.Constant) and k.value.value is False
+                        for k in node.keywords)
+                    if not allow:
+                        found.append(f"{where} {f.value.id}.{f.attr}()")
+            elif isinstance(node, (ast.Import, ast.ImportFrom)):
+                names = [a.name for a in node.names] if isinstance(node, ast.Import) \
+                    else [node.module or ""]
+                found += [f"{where} import {n}" for n in names
+                          if n.split(".")[0] in banned_modules]
+    assert found == [], "code that could run or fetch content: " + "; ".join(found)
