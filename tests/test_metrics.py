@@ -58,6 +58,7 @@ def test05_mask_selects_pixels():
 
 def test06_identical_images_are_zero_and_shapes_must_match():
     a = np.random.default_rng(2).uniform(size=(3, 3, 3))
-    assert metrics.all_metrics(a, a) == {"mae": 0.0, "rmse": 0.0, "relmse": 0.0}
+    assert metrics.all_metrics(a, a) == {"mae": 0.0, "rmse": 0.0, "relmse": 0.0,
+                                          "flip": 0.0}
     with pytest.raises(ValueError):
         metrics.mae(a, a[:2])

@@ -9,24 +9,18 @@ solver. Time is meshing + form factors + solve (best of the runs).
 
 from __future__ import annotations
 
-import importlib.util
-
 import numpy as np
 
 from shadelab.scene.model import Scene
 from shadelab.studies import metrics
-from shadelab.studies.result import StudyResult, StudySkipped, study_clock
+from shadelab.studies.result import StudyResult, study_clock
 
 COLUMNS = ["series", "label", "patches", "form_factors", "resolution", "solver", "time_ms",
-           "mae", "rmse", "relmse"]
+           "mae", "rmse", "relmse", "flip"]
 CONVERGENCE_COLUMNS = ["solver", "iteration", "time_ms", "residual"]
 PRESET = "cornell"
 
 
-def _require() -> None:
-    for module in ("shadelab.radiosity.solution", "shadelab.radiosity.solvers"):
-        if importlib.util.find_spec(module) is None:
-            raise StudySkipped(f"{module} is not built yet")
 
 
 def solve_timed(scene: Scene, patches: int, method: str, resolution: int, solver: str,
@@ -47,7 +41,7 @@ def solve_timed(scene: Scene, patches: int, method: str, resolution: int, solver
 def _row(series, label, solution, method, resolution, solver, ms, image, reference):
     errors = metrics.all_metrics(image, reference)
     return [series, str(label), len(solution.patches), method, resolution, solver, ms,
-            errors["mae"], errors["rmse"], errors["relmse"]]
+            errors["mae"], errors["rmse"], errors["relmse"], errors["flip"]]
 
 
 def convergence(solution, solver: str) -> list[list]:
@@ -65,7 +59,6 @@ def convergence(solution, solver: str) -> list[list]:
 
 def run_radiosity(quick: bool = False) -> StudyResult:
     """Error vs time over patches, form factors, hemicube resolution and solvers (Cornell)."""
-    _require()
     from shadelab.scene.preset import load_preset
 
     scene = load_preset(PRESET)
@@ -124,7 +117,6 @@ def auto_radiosity(scene: Scene, size: tuple[int, int], budget: float,
     scene itself; returns patches, resolution and a report line."""
     from shadelab.studies.autoquality import check_budget, choose_setting, front_from_rows
 
-    _require()
     budget = check_budget(budget)
     method = method or scene.radiosity.form_factors
     scale = min(1.0, max_side / max(size))

@@ -8,21 +8,16 @@ processes on the machine only ever add time.
 
 from __future__ import annotations
 
-import importlib.util
-
 import numpy as np
 
 from shadelab.scene.model import Scene
 from shadelab.studies import metrics
-from shadelab.studies.result import StudyResult, StudySkipped, study_clock
+from shadelab.studies.result import StudyResult, study_clock
 
-COLUMNS = ["depth", "spp", "time_ms", "mae", "rmse", "relmse"]
+COLUMNS = ["depth", "spp", "time_ms", "mae", "rmse", "relmse", "flip"]
 PRESET = "whitted"   # a mirror and a glass sphere over a checkerboard: depth matters
 
 
-def _require() -> None:
-    if importlib.util.find_spec("shadelab.raytrace.whitted") is None:
-        raise StudySkipped("shadelab.raytrace.whitted is not built yet")
 
 
 def trace(scene: Scene, size: tuple[int, int], depth: int, spp: int, ctx, seed: int = 0):
@@ -51,13 +46,13 @@ def measure(scene: Scene, size: tuple[int, int], depths, spps, reference: tuple[
             best[(depth, spp)] = min(best[(depth, spp)], ms)
             errors[(depth, spp)] = metrics.all_metrics(image, ref)
     return [[depth, spp, best[(depth, spp)], errors[(depth, spp)]["mae"],
-             errors[(depth, spp)]["rmse"], errors[(depth, spp)]["relmse"]]
+             errors[(depth, spp)]["rmse"], errors[(depth, spp)]["relmse"],
+             errors[(depth, spp)]["flip"]]
             for depth, spp in settings]
 
 
 def run_raytrace(quick: bool = False) -> StudyResult:
     """Error vs time of the Whitted tracer on cornell-spheres over depth and spp."""
-    _require()
     from shadelab.scene.preset import load_preset
 
     scene = load_preset(PRESET)
@@ -85,7 +80,6 @@ def auto_raytrace(scene: Scene, size: tuple[int, int], budget: float,
     probe of the scene itself; returns depth, spp and a report line."""
     from shadelab.studies.autoquality import check_budget, choose_setting, front_from_rows
 
-    _require()
     budget = check_budget(budget)
     scale = min(1.0, max_side / max(size))
     probe = (max(8, round(size[0] * scale)), max(8, round(size[1] * scale)))

@@ -22,7 +22,7 @@ from shadelab.studies.result import StudyResult, study_clock
 LEVELS = tuple(range(6))                 # icosphere subdivision levels studied
 METHODS = ("flat", "gouraud", "phong")   # raster shading modes
 COLUMNS = ["method", "level", "triangles", "time_ms", "mae", "rmse", "relmse", "silhouette",
-           "relmse_both"]
+           "relmse_both", "flip"]
 
 
 def study_scene() -> Scene:
@@ -152,7 +152,8 @@ def measure_sphere(scene: Scene, index: int, shading: str, size: tuple[int, int]
         errors = metrics.all_metrics(image, reference, mask)
         triangles = 20 * 4 ** level
         rows.append([shading, level, triangles, ms, errors["mae"], errors["rmse"],
-                     errors["relmse"], silhouette, metrics.relmse(image, reference, both)])
+                     errors["relmse"], silhouette, metrics.relmse(image, reference, both),
+                     errors["flip"]])
     return rows
 
 
