@@ -26,6 +26,7 @@ COMMAND_MODULES = (
     "shadelab.cli.studies",
     "shadelab.cli.bench",
     "shadelab.cli.view",
+    "shadelab.cli.sweep",
 )
 
 EXIT_BAD_INPUT = 2
@@ -42,6 +43,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="shadelab",
                      description="ShadeLab: an interactive lab for illumination and shading. "
                                  "Run 'shadelab [PRESET]' to open the viewer (default: lecture).")
+    from shadelab import __version__
+
+    parser.add_argument("--version", action="version", version=f"shadelab {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     for name in COMMAND_MODULES:
         importlib.import_module(name).add_parser(sub)
@@ -61,7 +65,7 @@ def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     parser = build_parser()
     commands = set(parser._subparsers._group_actions[0].choices)  # noqa: SLF001
-    if not argv or (argv[0] not in commands and argv[0] not in ("-h", "--help")):
+    if not argv or (argv[0] not in commands and argv[0] not in ("-h", "--help", "--version")):
         argv = ["view", *argv]  # 'shadelab [PRESET] [view options]' opens the viewer
     saved_allow = os.environ.get(ALLOW_ENV)
     saved_term = None
