@@ -1,7 +1,7 @@
 """Stability, property-based: no NaN, Inf or negative pixel, no crash, for any coefficients,
 light placement or mesh the scene model accepts (extreme ones included: n = 0 and 1e4,
 c1 = c2 = c3 = 0, Ip = 0, kd + ks > 1, a light on the surface, zero normals, degenerate
-triangles). Renderers that are not built yet are skipped.
+triangles).
 """
 
 from __future__ import annotations

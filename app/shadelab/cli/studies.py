@@ -45,17 +45,12 @@ def run_charts(args: argparse.Namespace) -> int:
             raise ShadeLabError(f"--only '{name}': expected one of {', '.join(known)}")
     out = make_out_dir(args.out)
     from shadelab.studies.charts import write_chart
-    from shadelab.studies.result import StudySkipped
 
     for name in known:
         if args.only and name not in args.only:
             continue
         print(f"charts: {name} ...", file=sys.stderr, flush=True)
-        try:
-            result = run_study(name, bool(args.quick))
-        except StudySkipped as exc:
-            print(f"skipped {name}: {exc}")
-            continue
+        result = run_study(name, bool(args.quick))
         for path in write_chart(result, out):
             print(f"wrote {path}")
         for note in result.notes:
@@ -65,7 +60,7 @@ def run_charts(args: argparse.Namespace) -> int:
 
 def run_gallery(args: argparse.Namespace) -> int:
     from shadelab.imageio import parse_size, write_png
-    from shadelab.studies.gallery import GALLERY, GallerySkipped, render_case
+    from shadelab.studies.gallery import GALLERY, render_case
 
     size = parse_size(args.size)
     names = [case.name for case in GALLERY]
@@ -79,11 +74,7 @@ def run_gallery(args: argparse.Namespace) -> int:
     for case in GALLERY:
         if args.only and case.name not in args.only:
             continue
-        try:
-            image, exposure = render_case(case, size)
-        except GallerySkipped as exc:
-            print(f"skipped {case.name}: {exc}")
-            continue
+        image, exposure = render_case(case, size)
         path = out / f"{case.name}.png"
         write_png(str(path), image, exposure)
         print(f"wrote {path}")

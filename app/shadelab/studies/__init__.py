@@ -3,13 +3,13 @@
 Each study module has ``run_<study>(quick: bool) -> StudyResult`` (pure data: rows and
 columns the viewer's Studies panel plots with ImPlot and ``shadelab charts`` draws with
 matplotlib). Modules of other layers (ray tracer, radiosity, shadow volumes) are imported
-lazily; a study whose renderer is not built yet raises :class:`StudySkipped`.
+lazily, when their study runs.
 
 For the viewer::
 
     from shadelab.studies import STUDIES, run_study
     for name, title in STUDIES: ...
-    result = run_study("shading", quick=True)      # StudyResult, or raises StudySkipped
+    result = run_study("shading", quick=True)      # StudyResult
     for series, rows in result.series().items():
         xs, ys = result.column(result.x, rows), result.column(result.y, rows)
 """
@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import importlib
 
-from shadelab.studies.result import StudyResult, StudySkipped
+from shadelab.studies.result import StudyResult
 
 # name -> (module, function, title)
 _STUDY_TABLE = {
@@ -33,13 +33,9 @@ STUDIES: tuple[tuple[str, str], ...] = tuple((n, t[2]) for n, t in _STUDY_TABLE.
 
 
 def run_study(name: str, quick: bool = True) -> StudyResult:
-    """Run one study by name; raises StudySkipped when its renderer is not built yet."""
+    """Run one study by name (one of :data:`STUDIES`)."""
     module_name, function, _ = _STUDY_TABLE[name]
-    try:
-        module = importlib.import_module(module_name)
-    except ModuleNotFoundError as exc:
-        raise StudySkipped(f"{name}: module {exc.name} is not built yet") from None
-    return getattr(module, function)(quick)
+    return getattr(importlib.import_module(module_name), function)(quick)
 
 
-__all__ = ["STUDIES", "StudyResult", "StudySkipped", "run_study"]
+__all__ = ["STUDIES", "StudyResult", "run_study"]

@@ -9,14 +9,9 @@ A method is ``raster:<shading>``, ``raytrace``, ``pathtrace[:<spp>]`` or
 
 from __future__ import annotations
 
-import importlib.util
 from dataclasses import dataclass
 
 import numpy as np
-
-
-class GallerySkipped(Exception):
-    """A case cannot be drawn here (its renderer or preset is not built yet)."""
 
 
 @dataclass(frozen=True)
@@ -29,7 +24,6 @@ class GalleryCase:
     method: str                  # see the module docstring
     explanation: str             # what fails, and what ShadeLab does about it
     test_name: str               # tests/<file>::<test> that asserts the failure
-    requires: str = ""           # a module that must exist (another layer's feature)
 
 
 T = "tests/test_gallery.py::"
@@ -61,46 +55,46 @@ GALLERY: list[GalleryCase] = [
         "z-pass stencil counting starts from zero at the eye: with the eye inside a shadow "
         "volume every count is off by one and lit and shadowed regions swap. ShadeLab uses "
         "z-fail (Carmack's reverse) with capped volumes by default, which counts from infinity.",
-        T + "test04_zpass_fails_with_the_eye_inside", requires="shadelab.render.shadows"),
+        T + "test04_zpass_fails_with_the_eye_inside"),
     GalleryCase(
         "non-closed-caster", "fail-open-caster", ("render.shadows=volumes",), "raster:phong",
         "Shadow volumes need closed, consistently wound casters: an open mesh has silhouette "
         "edges with one face, so its volume would leak and stencil counts go wrong. ShadeLab "
         "gives an open (or inconsistently wound) caster one small closed volume per triangle "
         "(shadelab.geometry.silhouette): the shadow stays right, at more fill cost.",
-        T + "test05_open_caster", requires="shadelab.render.shadows"),
+        T + "test05_open_caster"),
     GalleryCase(
         "painter-cyclic", "painter-cyclic", ("render.visibility=painter",), "raster:phong",
         "The painter's algorithm sorts whole polygons by depth; three polygons that overlap in "
         "a cycle have no correct order, so one is always drawn wrongly on top. The z-buffer "
         "(ShadeLab's default) resolves visibility per pixel.",
-        T + "test06_painter_cycle", requires="shadelab.render.painter"),
+        T + "test06_painter_cycle"),
     GalleryCase(
         "shadow-acne", "fail-shadow-acne", ("raytrace.offset=0",), "raytrace",
         "A shadow ray starting exactly on the surface can hit that same surface through "
         "rounding, speckling lit areas with false shadow (acne). ShadeLab moves ray origins "
         "off the surface by raytrace.offset (1e-3 of the scene size by default).",
-        T + "test07_shadow_acne_without_offset", requires="shadelab.raytrace.whitted"),
+        T + "test07_shadow_acne_without_offset"),
     GalleryCase(
         "total-internal-reflection", "fail-tir", (), "raytrace",
         "Inside glass (ior 1.5) a ray meeting the surface beyond the critical angle "
         "asin(1/1.5) = 41.8 degrees cannot leave: Snell's law has no solution (the square root "
         "of a negative). ShadeLab detects it and gives the transmitted weight to the mirror ray, "
         "so the rim of the glass ball reflects instead of going black or NaN.",
-        T + "test08_total_internal_reflection", requires="shadelab.raytrace.whitted"),
+        T + "test08_total_internal_reflection"),
     GalleryCase(
         "hemicube-aliasing", "cornell",
         ("radiosity.form_factors=hemicube", "radiosity.hemicube_resolution=8"), "radiosity",
         "A hemicube samples the hemisphere with a pixel grid: small or distant patches fall "
         "between pixel centres or snap to whole pixels, so form factors alias (Baum et al. "
         "1989). Raise radiosity.hemicube_resolution or use raycast/analytic form factors.",
-        T + "test09_hemicube_aliasing", requires="shadelab.radiosity.solution"),
+        T + "test09_hemicube_aliasing"),
     GalleryCase(
         "radiosity-light-leak", "radiosity-leak", ("radiosity.patches=40",), "radiosity:uniform",
         "A patch that runs under a wall is lit as a whole, so light appears on the dark side "
         "(a leak); radiosity is constant per patch. Mesh along the contact lines or use more "
         "patches.",
-        T + "test10_radiosity_light_leak", requires="shadelab.radiosity.solution"),
+        T + "test10_radiosity_light_leak"),
     GalleryCase(
         "degenerate-triangles", "fail-degenerate", (), "raster:gouraud",
         "A zero-area triangle has no normal. ShadeLab gives it a zero face normal, falls back to "
@@ -147,17 +141,6 @@ def case_named(name: str) -> GalleryCase:
     raise KeyError(name)
 
 
-def available(case: GalleryCase) -> str:
-    """'' when the case can be drawn here, else why not."""
-    from shadelab.resources import presets_dir
-
-    if case.requires and importlib.util.find_spec(case.requires) is None:
-        return f"{case.requires} is not built yet"
-    if not (presets_dir() / f"{case.preset}.toml").is_file():
-        return f"preset {case.preset} is not written yet"
-    return ""
-
-
 def load_case(case: GalleryCase):
     from shadelab.scene.preset import load_preset
 
@@ -166,9 +149,6 @@ def load_case(case: GalleryCase):
 
 def render_case(case: GalleryCase, size: tuple[int, int]) -> tuple[np.ndarray, float]:
     """The case's image (H, W, 3) float32 linear and the exposure to write it with."""
-    why = available(case)
-    if why:
-        raise GallerySkipped(why)
     scene = load_case(case)
     kind, _, variant = case.method.partition(":")
     if kind == "raster":
@@ -187,7 +167,7 @@ def render_case(case: GalleryCase, size: tuple[int, int]) -> tuple[np.ndarray, f
     elif kind == "radiosity":
         image = _render_radiosity(scene, size, adaptive=variant != "uniform")
     else:
-        raise GallerySkipped(f"method {case.method} is not known here")
+        raise ValueError(f"gallery case {case.name}: unknown method {case.method}")
     return np.asarray(image, dtype=np.float32), scene.render.exposure
 
 

@@ -9,10 +9,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 
-class StudySkipped(Exception):
-    """A study cannot run here (its renderer is not built yet); the message says why."""
-
-
 @dataclass
 class StudyResult:
     """One study's measurements, ready to plot.

@@ -14,7 +14,7 @@ from shadelab.errors import ShadeLabError
 from shadelab.scene.camera import primary_rays
 from shadelab.scene.model import Scene
 from shadelab.scene.preset import load_preset
-from shadelab.studies.result import StudyResult, StudySkipped, study_clock
+from shadelab.studies.result import StudyResult, study_clock
 
 COLUMNS = ["scene", "method", "triangles", "time_ms", "oracle_ms", "mismatch"]
 SCENES = ("shadows", "shadows-colored", "fail-open-caster", "fail-zpass-eye-inside")
@@ -99,17 +99,8 @@ def measure(scene: Scene, size: tuple[int, int], method: str, repeats: int) -> l
     return [method, triangles, frame_ms(scene, size, repeats), oracle, share]
 
 
-def _require() -> None:
-    import importlib.util
-
-    for module in ("shadelab.render.shadows", "shadelab.raytrace.surface"):
-        if importlib.util.find_spec(module) is None:
-            raise StudySkipped(f"{module} is not built yet")
-
-
 def run_shadows(quick: bool = False) -> StudyResult:
     """Stencil volumes (z-fail, z-pass) against shadow rays on the shadow presets."""
-    _require()
     size = (64, 48) if quick else (240, 180)
     repeats = 2 if quick else 7
     rows, skipped = [], []

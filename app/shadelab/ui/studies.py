@@ -16,7 +16,6 @@ from shadelab.errors import ShadeLabError
 from shadelab.progress import Progress
 from shadelab.ui.jobs import JobRunner
 
-SKIPPED_PREFIX = "StudySkipped: "
 OFFLINE_JOB_OF_METHOD = {"raytrace": "Whitted", "pathtrace": "Path", "radiosity": "Radiosity"}
 
 
@@ -26,8 +25,7 @@ OFFLINE_JOB_OF_METHOD = {"raytrace": "Whitted", "pathtrace": "Path", "radiosity"
 def study_job(name: str, quick: bool) -> Iterator[Progress]:
     """One study as a job (module level: it pickles into the worker process).
 
-    Yields a single Progress whose ``stats["result"]`` is the :class:`StudyResult`; a
-    :class:`StudySkipped` reaches the runner as an error ``"StudySkipped: <why>"``.
+    Yields a single Progress whose ``stats["result"]`` is the :class:`StudyResult`.
     """
     from shadelab.studies import run_study
 
@@ -44,13 +42,12 @@ class StudyRun:
     name: str = ""
     quick: bool = True
     result: object = None          # shadelab.studies.result.StudyResult of the last finished run
-    skipped: str = ""              # StudySkipped message of the last run
     error: str = ""                # any other failure of the last run
     _seen: int = -1
 
     def start(self, name: str, quick: bool = True) -> None:
         self.name, self.quick = name, quick
-        self.skipped = self.error = ""
+        self.error = ""
         self._seen = -1
         self.runner.start(f"study {name}", lambda: study_job(name, quick),
                           call=(study_job, name, quick))
@@ -64,15 +61,13 @@ class StudyRun:
         return self.runner.elapsed
 
     def poll(self) -> None:
-        """Take a finished job's result (or its skip message / error); call once a frame."""
+        """Take a finished job's result (or its error); call once a frame."""
         if not self.runner.started or self.runner.running or self._seen == self.runner.version:
             return
         latest, version = self.runner.snapshot()
         self._seen = version
         error = self.runner.error
-        if error.startswith(SKIPPED_PREFIX):
-            self.skipped = error[len(SKIPPED_PREFIX):]
-        elif error:
+        if error:
             self.error = error
         elif self.runner.cancelled:
             self.error = "cancelled"

@@ -148,8 +148,6 @@ def draw_studies_panel(state: AppState) -> bool:
         spin = SPINNER[int(time.perf_counter() * 8) % len(SPINNER)]
         imgui.text(f"{spin} running the {run.name} study "
                    f"({'quick' if run.quick else 'full'})...  {run.elapsed:.1f} s")
-    elif run.skipped:
-        _wrapped(f"{run.name} skipped: {run.skipped}", panels.DIM_COLOR)
     elif run.error:
         _wrapped(f"{run.name} failed: {run.error}", panels.ERROR_COLOR)
     result = run.result
@@ -186,7 +184,7 @@ def draw_studies_panel(state: AppState) -> bool:
 
 def draw_gallery_panel(state: AppState) -> bool:
     """List the failure gallery; the selected case's explanation; open it in the viewer."""
-    from shadelab.studies.gallery import GALLERY, available
+    from shadelab.studies.gallery import GALLERY
     from shadelab.ui.offline import start_job_by_label
 
     if imgui.begin_list_box("##cases", imgui.ImVec2(-1, 150)):
@@ -205,9 +203,6 @@ def draw_gallery_panel(state: AppState) -> bool:
     _wrapped(case.explanation)
     imgui.separator()
     _wrapped(f"test: {case.test_name}", panels.DIM_COLOR)
-    why = available(case)
-    if why:
-        _wrapped(f"not drawable here yet: {why}", panels.DIM_COLOR)
     if imgui.button("Open in viewer"):
         open_case(state, case)
     job = offline_job_of(case)
