@@ -41,3 +41,43 @@ def test_wheel_renders_from_any_directory(tmp_path):
     assert out.returncode == 0, out.stderr
     assert out.stdout.splitlines()[0].startswith(str(site))  # the wheel's copy, not the repo's
     assert (elsewhere / "x.png").stat().st_size > 100
+
+
+@pytest.mark.slow
+def test_sdist_builds_and_carries_what_a_release_needs(tmp_path):
+    """The sdist (python -m build --sdist) holds the sources, the license and the changelog,
+    and its version is the package's __version__ (one place)."""
+    import tarfile
+
+    import shadelab
+
+    build = subprocess.run([sys.executable, "-m", "build", "--sdist", "--no-isolation",
+                            "--outdir", str(tmp_path), str(ROOT)], capture_output=True,
+                           text=True)
+    assert build.returncode == 0, build.stderr[-3000:]
+    (sdist,) = tmp_path.glob("shadelab-*.tar.gz")
+    assert sdist.name == f"shadelab-{shadelab.__version__}.tar.gz"
+    with tarfile.open(sdist) as tar:
+        names = {name.split("/", 1)[1] for name in tar.getnames() if "/" in name}
+    for needed in ("LICENSE", "CHANGELOG.md", "README.md", "pyproject.toml",
+                   "app/shadelab/__init__.py", "app/shadelab/api.py", "shaders/phong.frag",
+                   "presets/cornell.toml", "examples/quickstart.py"):
+        assert needed in names, needed
+
+
+def test_version_has_one_source():
+    import tomllib
+
+    import shadelab
+    from shadelab.cli import main
+
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    assert "version" not in project and "version" in project["dynamic"]
+    out = subprocess.run([sys.executable, "-m", "shadelab", "--version"], capture_output=True,
+                         text=True)
+    assert out.returncode == 0 and out.stdout.strip() == f"shadelab {shadelab.__version__}"
+    assert "bench" in project["optional-dependencies"]
+    assert callable(main)
+    from importlib.metadata import entry_points
+
+    assert any(e.value == "shadelab.testing" for e in entry_points(group="pytest11"))
