@@ -200,6 +200,7 @@ def _start(state: AppState, name: str, scene, size) -> None:
     view.version = -1
     view.record = JobRecord(f"viewport {name}", tuple(size), since_start(time.perf_counter()))
     view.log.append(view.record)
+    view.stats = {}
     if name == "radiosity" and view.step_mode:
         gate = _StepGate(view.runner._cancel)
         view.stats["gate"] = gate
@@ -541,11 +542,12 @@ def draw_ray_tree(state: AppState, draw_list, origin, display_size) -> None:
     thick = 4.0 if state.presenter else 3.0
     for kind, start, end, node in segments:
         pts, front = project(scene, display_size, np.stack([start, end]))
-        if not front.all():
+        if not front[1]:
             continue
         a = imgui.ImVec2(origin.x + pts[0, 0], origin.y + pts[0, 1])
         b = imgui.ImVec2(origin.x + pts[1, 0], origin.y + pts[1, 1])
-        draw_list.add_line(a, b, RAY_COLORS[kind], thick)
+        if front[0]:   # (a primary ray starts at the eye: it projects to its end point)
+            draw_list.add_line(a, b, RAY_COLORS[kind], thick)
         if node.end is not None and node.kind != "shadow":
             draw_list.add_circle_filled(b, thick + 2, RAY_COLORS[kind])
             _label(draw_list, imgui.ImVec2(b.x + 8, b.y - 8),

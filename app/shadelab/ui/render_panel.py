@@ -169,6 +169,8 @@ def draw_pipeline_figures(state: AppState) -> None:
     if view is None:
         return
     name = pipelines.current(state)
+    if name == "radiosity":
+        _draw_radiosity_stepper(view)
     if name == "radiosity" and view.history.get("iteration"):
         _draw_residual_plot(view)
     if name == "raytrace":
@@ -177,6 +179,24 @@ def draw_pipeline_figures(state: AppState) -> None:
                                           "tree is drawn there")
             return
         draw_ray_tree_table(state, view)
+
+
+def _draw_radiosity_stepper(view) -> None:
+    """Play (shots stream) or step: one shot per press, the shooting patch highlighted."""
+    imgui.text("Progressive refinement:")
+    imgui.same_line()
+    if imgui.small_button("Play" if view.step_mode else "Restart"):
+        view.step_mode, view.key = False, None   # a new job, shots streaming
+    imgui.same_line()
+    if not view.step_mode:
+        if imgui.small_button("Step mode"):
+            view.step_mode, view.key = True, None
+        return
+    gate = view.stats.get("gate")
+    imgui.begin_disabled(gate is None or not view.runner.running)
+    if imgui.small_button("Shoot next patch"):
+        gate.step()
+    imgui.end_disabled()
 
 
 def _draw_residual_plot(view) -> None:
