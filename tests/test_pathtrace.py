@@ -10,8 +10,9 @@ import pytest
 from shadelab.cli import main
 from shadelab.raytrace.pathtrace import iter_pathtrace, render_pathtraced
 from shadelab.scene.camera import primary_rays
-from shadelab.scene.model import Camera, Material, Object, Scene
+from shadelab.scene.model import Camera, Light, Material, Object, Scene
 from shadelab.scene.preset import load_preset
+from shadelab.shading.reference import shade
 
 
 def _furnace(rho: tuple, le: tuple) -> Scene:
@@ -142,3 +143,64 @@ def test_cli_pathtrace_bad_input_exits_2(tmp_path, capsys, argv):
     code = main(["pathtrace", "cornell", "-o", str(tmp_path / "p.png"), *argv])
     err = capsys.readouterr().err.strip()
     assert code == 2 and len(err.splitlines()) == 1 and err.startswith("shadelab: error:")
+
+
+# ---------------------------------------------------------------- the lecture's lights
+
+_LIGHTS = {
+    "point": Light(kind="point", position=(0.3, 1.2, 0.8), Ip=(0.9, 0.7, 0.5),
+                   attenuation="lecture", c1=0.5, c2=0.3, c3=0.2),
+    "spot": Light(kind="spot", position=(0.0, 1.5, 0.0), direction=(0.1, -1.0, 0.05),
+                  Ip=(1.0, 1.0, 0.8), cone_angle=35.0, spot_exponent=4.0,
+                  attenuation="inverse_square"),
+    "directional": Light(kind="directional", direction=(-0.4, -1.0, -0.3), Ip=(0.6, 0.8, 1.0)),
+}
+
+
+@pytest.mark.parametrize("kind", sorted(_LIGHTS))
+@pytest.mark.parametrize("specular", ["phong", "blinn"])
+@pytest.mark.parametrize("local", ["numba", "numpy"])
+def test_first_bounce_of_a_lecture_light_is_the_local_model(kind, specular, local):
+    """One plane under a point, spot or directional light, nothing else to bounce off: each
+    camera path's radiance is exactly the lecture's I = S f_att Ip [kd Od N.L + ks Os (R.V)^n]
+    at its hit (ambient left to the paths), whatever the estimator's random numbers."""
+    from shadelab.raytrace.pathtrace import PathTracer
+
+    plane = Material(ka=0.3, kd=0.6, Od=(0.9, 0.5, 0.3), ks=0.4, n=20.0, Os=(1.0, 0.9, 0.8))
+    light = _LIGHTS[kind]
+    scene = Scene(Ia=(0.2, 0.2, 0.2), lights=[light], materials={"m": plane},
+                  camera=Camera(eye=(0.4, 1.0, 2.5), target=(0.0, 0.0, 0.0), fov_y=50.0),
+                  objects=[Object(shape="quad", material="m",
+                                  vertices=[[-2, 0, 2], [2, 0, 2], [2, 0, -2], [-2, 0, -2]])])
+    scene.render.specular = specular
+    tracer = PathTracer(scene, local=local)
+    o, d = primary_rays(scene.camera, 32, 24)
+    o, d = o.reshape(-1, 3), d.reshape(-1, 3)
+    got = tracer.radiance(o, d, np.random.default_rng(3))
+    t = -o[:, 1] / d[:, 1]
+    on_plane = (t > 0) & np.all(np.abs((o + t[:, None] * d)[:, [0, 2]]) < 2.0, axis=1)
+    assert on_plane.mean() > 0.5
+    points = o[on_plane] + t[on_plane, None] * d[on_plane]
+    expected = shade(points, np.array([0.0, 1.0, 0.0]), scene.camera.eye, plane, [light],
+                     (0.0, 0.0, 0.0), specular)
+    np.testing.assert_allclose(got[on_plane], expected, rtol=1e-6, atol=1e-9)
+    assert expected.max() > 0.05 and np.all(got[~on_plane] == 0.0)
+
+
+def test_a_stand_in_light_is_left_to_the_surface_it_stands_for():
+    """Cornell's point light stands in for the ceiling quad: the path tracer skips it (the
+    image is the same with the light removed), and a scene lit only by stand-ins is refused."""
+    scene = load_preset("cornell")
+    assert [light.stand_in for light in scene.lights] == [True]
+    with_light = render_pathtraced(scene, (12, 12), 2, seed=4)
+    scene.lights = []
+    np.testing.assert_array_equal(render_pathtraced(scene, (12, 12), 2, seed=4), with_light)
+    from shadelab.errors import ShadeLabError
+    from shadelab.raytrace.pathtrace import check_lit
+
+    dark = load_preset("cornell")
+    for material in dark.materials.values():
+        material.emission = (0.0, 0.0, 0.0)
+    with pytest.raises(ShadeLabError, match="stand_in"):
+        check_lit(dark, "cornell")
+    check_lit(load_preset("whitted"), "whitted")  # lit by its lights alone: accepted

@@ -300,10 +300,9 @@ def render(scene: Scene | str, size: Any = None, shading: str | None = None,
         return Image(last.image, exposure, info)
     if pipeline == "pathtrace":
         _check_scene(scene, label)
-        if not any(np.max(scene.materials[o.material].emission) > 0.0 for o in scene.objects):
-            raise ShadeLabError(f"{label}: materials: the path tracer needs an emitter "
-                                "(a material with emission > 0 on some object)")
-        from shadelab.raytrace.pathtrace import iter_pathtrace
+        from shadelab.raytrace.pathtrace import check_lit, iter_pathtrace
+
+        check_lit(scene, label)
 
         spp = 64 if spp is None else spp
         last = run_to_end(iter_pathtrace(scene, wh, spp, seed, backend, workers=workers),

@@ -5,8 +5,6 @@ from __future__ import annotations
 import argparse
 import sys
 
-import numpy as np
-
 from shadelab import limits
 from shadelab.errors import ShadeLabError
 from shadelab.imageio import add_scene_arguments, check_outputs, parse_size, save_outputs
@@ -117,14 +115,11 @@ def run_pathtrace(args: argparse.Namespace) -> int:
     _check_scene(scene, args.preset)
     limits.check_pixels(size)
     limits.check_samples(size, args.spp)
-    emitters = [o for o in scene.objects
-                if np.max(scene.materials[o.material].emission) > 0.0]
-    if not emitters:
-        raise ShadeLabError(f"{args.preset}: materials: the path tracer needs an emitter "
-                            "(a material with emission > 0 on some object)")
+    from shadelab.raytrace.pathtrace import check_lit, iter_pathtrace
+
+    check_lit(scene, args.preset)
     check_outputs(args)
     from shadelab.progress import run_to_end
-    from shadelab.raytrace.pathtrace import iter_pathtrace
 
     last = run_to_end(iter_pathtrace(scene, size, args.spp, args.seed, args.backend,
                                      workers=args.workers), desc="pathtrace")

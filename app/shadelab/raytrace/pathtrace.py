@@ -4,10 +4,16 @@
 
 Units follow DESIGN.md section 2: radiance throughout, a diffuse BRDF f = rho / pi with
 rho = kd * Od, and a material's ``emission`` is its radiance Le (two-sided, as the raster
-shows it). Point, spot and directional lights are not sampled: the lecture's raster and
-Whitted stand-ins for area lights have no place in the rendering equation; only emitting
-triangles light the scene. Ideal mirrors (``Material.mirror``) and glass (``kt``, Fresnel
-reflection or Snell refraction) are delta lobes; Phong's ks highlight is not modelled.
+shows it). The lecture's point, spot and directional lights light the scene too, as delta
+lights sampled at every path vertex: their direct term is exactly the lecture's
+S_i f_att Ip [kd Od (N.L) + ks Os (R.V)^n] (no ambient term: the paths carry the indirect
+light the ambient term stood for), i.e. a lecture light of intensity Ip is a point source of
+radiant intensity pi Ip for the diffuse BRDF rho / pi, so a path tracer's first bounce equals
+the raster and Whitted images and everything after it is global illumination. A light marked
+``stand_in`` (the Cornell box's point light for its ceiling quad) is skipped: the emitting
+surface it stands for lights the paths. Ideal mirrors (``Material.mirror``) and glass
+(``kt``, Fresnel reflection or Snell refraction) are delta lobes; the ks highlight appears in
+the delta lights' direct term, not as a sampled lobe.
 
 Estimator (per path vertex, all paths of a bounce as one numpy batch, rays cast by Embree):
 
@@ -34,6 +40,7 @@ from typing import Iterator
 
 import numpy as np
 
+from shadelab.constants import T_INF
 from shadelab.errors import ShadeLabError
 from shadelab.progress import Progress
 from shadelab.raytrace import kernels
@@ -45,6 +52,16 @@ from shadelab.scene.model import Scene
 TILE_PATHS = 16384    # paths per work unit (one chunk of the generator)
 MAX_BOUNCES = 64      # hard cap; Russian roulette ends paths long before
 RR_START = 3          # bounces before Russian roulette starts
+
+
+def check_lit(scene: Scene, label: str) -> None:
+    """Refuse a scene with nothing to light its paths: no emitting object and no light that
+    is on and not a ``stand_in``."""
+    emitters = [o for o in scene.objects if max(scene.materials[o.material].emission) > 0.0]
+    lights = [light for light in scene.active_lights() if not light.stand_in]
+    if not emitters and not lights:
+        raise ShadeLabError(f"{label}: the path tracer needs an emitter (a material with "
+                            "emission > 0 on some object) or a light that is not a stand_in")
 
 
 class Emitters:
@@ -112,6 +129,12 @@ class PathTracer:
         self.ior = np.array([m.ior for m in mats], float)
         self.emission = np.array([m.emission for m in mats], float).reshape(-1, 3)
         self.emitters = Emitters(self.ctx, self.emission)
+        # The lecture's delta lights (all but stand-ins), with a material table without the
+        # ambient and emission terms: those are counted by the paths themselves.
+        self.delta_lights = [light for light in self.ctx.lights if not light.stand_in]
+        self.delta_table = kernels.light_table(self.delta_lights)
+        self.direct_materials = self.ctx.material_table.copy()
+        self.direct_materials[:, kernels.M_LE:kernels.M_LE + 3] = 0.0
         self.rays = 0  # counter of rays cast (paths and shadow rays)
         self.primary_hits = 0  # counter of camera rays that hit something
 
@@ -143,6 +166,7 @@ class PathTracer:
             surf = ctx.surface(o, d, Hits(t, hits.tri[keep], hits.u[keep], hits.v[keep]))
             mat = ctx.object_material[surf.obj]
             _add(out, pixel, beta * self._emitted(surf, d, t, mat, bsdf_pdf))
+            _add(out, pixel, beta * self._delta_lights(surf, d, mat))
             rho = self.rho[mat]
             p_diffuse = rho.mean(axis=1) / np.maximum(
                 rho.mean(axis=1) + self.kr[mat] + self.kt[mat], 1e-300)
@@ -181,6 +205,9 @@ class PathTracer:
             t = hits.t[keep]
             surf = ctx.surface(o, d, Hits(t, hits.tri[keep], hits.u[keep], hits.v[keep]))
             mat = ctx.object_material[surf.obj]
+            if self.delta_lights:
+                kernels.add_rows(out, pixel, beta * self._delta_lights(surf, d, mat),
+                                 np.ones(len(pixel), np.bool_))
             (nee_o, nee_d, nee_t, nee_ok, nee_val, o, d, beta, bsdf_pdf,
              alive) = kernels.path_vertex(
                 out, pixel, beta, bsdf_pdf, surf.position, surf.normal, surf.geo_normal,
@@ -197,6 +224,29 @@ class PathTracer:
             o, d, beta, pixel, bsdf_pdf = (o[alive], d[alive], beta[alive], pixel[alive],
                                            bsdf_pdf[alive])
         return out
+
+    def _delta_lights(self, surf, d: np.ndarray, mat: np.ndarray) -> np.ndarray:
+        """The lecture's direct term of every (non stand-in) light at the hits, shadow rays
+        giving S_i (objects with ``cast_shadows = false`` do not block, as in Whitted)."""
+        n = len(d)
+        if not self.delta_lights or n == 0:
+            return np.zeros((n, 3))
+        ctx = self.ctx
+        pos = np.ascontiguousarray(surf.position)
+        ng = np.ascontiguousarray(surf.geo_normal)
+        shadow = np.zeros((len(self.delta_lights), n))
+        for k in range(len(self.delta_lights)):
+            origin, dirs, tmax, facing = kernels.shadow_rays(pos, ng, self.delta_table, k,
+                                                             ctx.eps, T_INF)
+            idx = np.flatnonzero(facing)
+            if len(idx):
+                blocked = ctx.accel.occluded(origin[idx], dirs[idx], tmax[idx])
+                shadow[k, idx] = np.where(blocked, 0.0, 1.0)
+                self.rays += len(idx)
+        return kernels.local_shade(pos, np.ascontiguousarray(surf.normal),
+                                   np.ascontiguousarray(-d), mat, self.direct_materials,
+                                   self.delta_table, np.zeros(3), ctx.specular == "blinn",
+                                   shadow)
 
     def _emitted(self, surf, d: np.ndarray, t: np.ndarray, mat: np.ndarray,
                  bsdf_pdf: np.ndarray) -> np.ndarray:

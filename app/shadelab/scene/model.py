@@ -115,6 +115,8 @@ class Light(Checked):
     c3: float = spec(0.0, "float", 0.0, COEFF_MAX, doc="f_att quadratic term, per distance squared")
     cone_angle: float = spec(30.0, "float", 0.0, 90.0, doc="spot half-angle, degrees")
     spot_exponent: float = spec(1.0, "float", 0.0, 1000.0, doc="spot falloff, cos^e")
+    stand_in: bool = spec(False, "bool", doc="stands in for an emitting surface in the raster "
+                          "and Whitted; the path tracer lights with that surface instead")
 
 
 @dataclass
