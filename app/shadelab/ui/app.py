@@ -304,6 +304,9 @@ class Viewer:
         imgui.image(imgui.ImTextureRef(texture.glo), imgui.ImVec2(*size),
                     uv0=imgui.ImVec2(0, 1), uv1=imgui.ImVec2(1, 0))
         imgui.set_cursor_screen_pos(origin)
+        if gizmos.wants_mouse():  # ImGuizmo activates only when no item is hovered
+            imgui.dummy(imgui.ImVec2(*size))
+            return None
         imgui.invisible_button("viewport_input", imgui.ImVec2(*size),
                                imgui.ButtonFlags_.mouse_button_left
                                | imgui.ButtonFlags_.mouse_button_right

@@ -35,6 +35,11 @@ def capturing() -> bool:
     return _using
 
 
+def wants_mouse() -> bool:
+    """The mouse is on a gizmo (or dragging one): the viewport leaves the click to it."""
+    return _using or bool(GIZMO.is_over())
+
+
 def column_major(matrix: np.ndarray):
     return GIZMO.Matrix16([float(v) for v in np.asarray(matrix, dtype=np.float64).T.reshape(-1)])
 
@@ -166,5 +171,8 @@ def draw_selector(state: AppState) -> None:
     names = [light.name or f"light {i}" for i, light in enumerate(lights)]
     index = min(max(state.gizmo_light, 0), len(lights) - 1)
     _, state.gizmo_light = imgui.combo("gizmo moves", index, names)
-    imgui.same_line()
+    from shadelab.ui.presenter import same_line_if_fits
+
+    if same_line_if_fits("show", radio=True):
+        imgui.same_line()
     _, state.show_gizmos = imgui.checkbox("show##gizmos", state.show_gizmos)

@@ -208,7 +208,7 @@ def draw_caption(draw, text: str, origin, size, scale: float) -> None:
     font_size = imgui.get_font_size() * scale
     pad = 10.0 * scale / 1.4
     wrap = max(size[0] - 2 * pad, 50.0)
-    text_size = font.calc_text_size_a(font_size, 1e9, wrap, text)
+    text_size = imgui.calc_text_size(text, False, wrap / scale) * scale
     x, y = origin.x + pad, origin.y + size[1] - text_size.y - 2 * pad
     draw.add_rect_filled(imgui.ImVec2(origin.x, y - pad / 2),
                          imgui.ImVec2(origin.x + size[0], origin.y + size[1]), 0xA0000000)
