@@ -438,7 +438,7 @@ def save_preset(scene: Scene, path: str | Path) -> None:
     path = Path(path)
     problem = output_problem(path)
     if problem:
-        raise ShadeLabError(f"{path}: cannot save the preset: {problem}")
+        raise ShadeLabError(f"{path}: cannot write the preset: {problem}")
     text = tomli_w.dumps(_rebased(scene_to_dict(scene), Path(scene.base_dir),
                                   resolve_link(path).absolute().parent))
     with OutputSet() as out:
