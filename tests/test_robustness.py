@@ -666,3 +666,33 @@ def test_no_code_path_evaluates_unpickles_or_fetches_content():
                 found += [f"{where} import {n}" for n in names
                           if n.split(".")[0] in banned_modules]
     assert found == [], "code that could run or fetch content: " + "; ".join(found)
+
+
+# ---------------------------------------------------------------- 9. saving keeps what the user had
+
+
+def test_save_over_a_read_only_preset_refuses_and_keeps_it(tmp_path):
+    from shadelab.scene.preset import save_preset
+
+    scene = load_preset(_preset(tmp_path, GOOD))
+    mine = tmp_path / "mine.toml"
+    mine.write_text("# my notes\n")
+    mine.chmod(0o444)
+    with pytest.raises(ShadeLabError, match="cannot write the preset: is read-only"):
+        save_preset(scene, mine)
+    assert mine.read_text() == "# my notes\n" and (mine.stat().st_mode & 0o777) == 0o444
+
+
+def test_save_through_a_symlink_updates_the_shared_target(tmp_path):
+    from shadelab.scene.preset import save_preset
+
+    scene = load_preset(_preset(tmp_path, GOOD))
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    (shared / "scene.toml").write_text("old")
+    link = tmp_path / "link.toml"
+    link.symlink_to(shared / "scene.toml")
+    save_preset(scene, link)
+    assert link.is_symlink()
+    assert load_preset(str(shared / "scene.toml")).materials["m"].kd == 0.5
+    assert sorted(p.name for p in shared.iterdir()) == ["scene.toml"]  # no temp file left
