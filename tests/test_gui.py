@@ -269,7 +269,7 @@ def scenario_save_reload(ctx, state, out: dict) -> None:
     ctx.window_focus("//Scene")
     ctx.set_ref("//Scene")
     ctx.item_input_value("File", target)
-    ctx.item_click("Save as")
+    ctx.item_click("Save to file")
     ctx.yield_(2)
     out["saved_kd"] = state.scene.materials["white"].kd
     out["title_saved"] = state.title()

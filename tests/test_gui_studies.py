@@ -56,7 +56,13 @@ def test_open_case_replaces_the_scene_like_open_preset():
     assert open_case(state, case_named("shininess-huge"))
     assert state.source == "fail-coefficients" and state.gallery_opened == "shininess-huge"
     assert state.scene.materials["paint"].n == 10000.0 and state.scene.render.shading == "phong"
-    assert not state.history.can_undo() and not state.dirty and state.error == ""
+    assert not state.dirty and state.error == ""
+    # opening a case is one undoable step, like loading a preset: undo brings the edit back
+    assert state.history.can_undo()
+    state.undo()
+    assert state.scene.materials["white"].kd == 0.3 and "paint" not in state.scene.materials
+    state.redo()
+    assert state.scene.materials["paint"].n == 10000.0
     assert open_case(state, case_named("total-internal-reflection"))
     assert "Whitted" in state.status and state.source == "fail-tir"
 
@@ -141,7 +147,7 @@ def test_study_run_takes_the_result_or_the_error(monkeypatch):
 def test_focus_takes_a_list_and_word_matches():
     from imgui_bundle import hello_imgui
 
-    from shadelab.ui.app import focus_windows
+    from shadelab.ui.layout import focus_windows
 
     windows = []
     for label, dock in (("Scene", "Left"), ("Lights", "Left"), ("Equation & probe", "Right"),

@@ -22,6 +22,7 @@ from shadelab.geometry.mesh import geometry_key, scene_meshes
 from shadelab.scene.model import Camera
 from shadelab.ui import gizmos, lesson, overlays, panels, pipelines, presenter
 from shadelab.ui.frame import guarded
+from shadelab.ui.layout import focus_windows
 from shadelab.ui.offline import draw_offline_panel
 from shadelab.ui.probe import probe
 from shadelab.ui.render_panel import draw_algorithms_panel
@@ -143,7 +144,7 @@ def _screenshot(state: AppState) -> None:
 
 
 def _save(state: AppState) -> None:
-    state.save_as(state.preset_path or state.open_path)
+    panels.save_here(state)
 
 
 K = imgui.Key
@@ -704,22 +705,6 @@ def _docking(viewer: Viewer) -> hello_imgui.DockingParams:
     return params
 
 
-def focus_windows(windows, focus: str) -> list[str]:
-    """Bring the named dock windows to the front: ``focus`` is a comma-separated list of label
-    prefixes (or words of a label: 'gallery' finds 'Failure gallery'); one window per dock
-    space. Returns the labels focused."""
-    chosen: dict[str, object] = {}
-    for wanted in (w.strip().lower() for w in focus.split(",") if w.strip()):
-        match = [w for w in windows if w.label.lower().startswith(wanted)] \
-            or [w for w in windows if wanted in w.label.lower()]
-        if match:
-            chosen[match[0].dock_space_name] = match[0]
-    for window in windows:
-        if window.dock_space_name in chosen:
-            window.focus_window_at_next_frame = window is chosen[window.dock_space_name]
-    return [w.label for w in chosen.values()]
-
-
 def _scene_panel(state: AppState) -> bool:
     panels.draw_file_panel(state)
     imgui.separator()
@@ -752,7 +737,8 @@ def runner_params(viewer: Viewer) -> hello_imgui.RunnerParams:
         viewer.state.fullscreen = True
         presenter.mark_fullscreen_applied()
     elif viewer.options.maximized:
-        params.app_window_params.window_size_state = hello_imgui.WindowSizeState.maximized
+        params.app_window_params.window_geometry.window_size_state = \
+            hello_imgui.WindowSizeState.maximized
     params.imgui_window_params.default_imgui_window_type = \
         hello_imgui.DefaultImGuiWindowType.provide_full_screen_dock_space
     params.imgui_window_params.enable_viewports = False

@@ -171,7 +171,7 @@ def draw_selector(state: AppState) -> None:
     names = [light.name or f"light {i}" for i, light in enumerate(lights)]
     index = min(max(state.gizmo_light, 0), len(lights) - 1)
     _, state.gizmo_light = imgui.combo("gizmo moves", index, names)
-    from shadelab.ui.presenter import same_line_if_fits
+    from shadelab.ui.layout import same_line_if_fits
 
     if same_line_if_fits("show", radio=True):
         imgui.same_line()

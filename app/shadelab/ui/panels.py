@@ -23,7 +23,7 @@ from shadelab.scene.model import (
 from shadelab.scene.preset import list_presets
 from shadelab.shading import reference
 from shadelab.ui import dialogs
-from shadelab.ui.presenter import same_line_if_fits
+from shadelab.ui.layout import same_line_if_fits
 from shadelab.ui.ranges import field_slider, intensity_range
 from shadelab.ui.state import COMPARE_LABELS, AppState
 
@@ -97,6 +97,28 @@ def scene_span(state: AppState) -> float:
 # ---------------------------------------------------------------- scene / file panel
 
 
+def _is_shipped(path: str) -> bool:
+    """True for a preset file that ShadeLab itself ships (never overwritten by Save)."""
+    from pathlib import Path
+
+    from shadelab.resources import presets_dir
+
+    try:
+        return Path(path).resolve().is_relative_to(presets_dir().resolve())
+    except OSError:
+        return False
+
+
+def save_here(state: AppState) -> None:
+    """Save (Ctrl+S): over the file the scene came from, unless nothing was saved yet or it is
+    a preset ShadeLab ships, which are never overwritten: then ask where (Save as)."""
+    target = state.preset_path or state.open_path
+    if target and not _is_shipped(target):
+        state.save_as(target)
+    else:
+        dialogs.ask(state, "save")
+
+
 def draw_file_panel(state: AppState) -> bool:
     """Open a preset from the list or a file; save; undo/redo."""
     if state.error:
@@ -112,23 +134,24 @@ def draw_file_panel(state: AppState) -> bool:
             if imgui.selectable(name, name == current)[0]:
                 state.request_open(name)  # asks first when there are unsaved edits
         imgui.end_combo()
+    # Native dialogs first (what a user reaches for), then a typed path for scripts and tests.
+    for label, purpose in (("Open...", "open"), ("Save", "save-here"), ("Save as...", "save"),
+                           ("Add mesh...", "mesh")):
+        if purpose != "open" and same_line_if_fits(label):
+            imgui.same_line()
+        if not imgui.button(label):
+            continue
+        if purpose == "save-here":
+            save_here(state)
+        else:
+            dialogs.ask(state, purpose)
     _, state.open_path = imgui.input_text("File", state.open_path)
     if imgui.button("Open file"):
         state.request_open(state.open_path)  # a preset replaces the scene; a mesh is added
-    if same_line_if_fits("Save as"):
+    if same_line_if_fits("Save to file"):
         imgui.same_line()
-    if imgui.button("Save as"):
+    if imgui.button("Save to file"):
         state.save_as(state.open_path)
-    if same_line_if_fits("Save"):
-        imgui.same_line()
-    if imgui.button("Save") and (state.preset_path or state.open_path):
-        state.save_as(state.preset_path or state.open_path)
-    for label, purpose in (("Open...", "open"), ("Save as...", "save"),
-                           ("Add mesh...", "mesh")):  # native dialogs
-        if purpose != "open" and same_line_if_fits(label):
-            imgui.same_line()
-        if imgui.button(label):
-            dialogs.ask(state, purpose)
     imgui.begin_disabled(not state.history.can_undo())
     if imgui.button("Undo (Ctrl+Z)"):
         state.undo()

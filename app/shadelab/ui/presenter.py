@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from imgui_bundle import hello_imgui, imgui
 
+from shadelab.ui.layout import same_line_if_fits
 from shadelab.ui.state import AppState
 
 PRESENTER_SCALE = 1.8          # font scale of presenter mode (ui/app.py applies it)
@@ -262,20 +263,6 @@ def draw_display_panel(state: AppState) -> bool:
     return False
 
 
-def same_line_if_fits(label: str, radio: bool = False) -> bool:
-    """True when a button (or, ``radio``, a radio button / checkbox) labelled ``label`` fits
-    on the line after the last item; else it goes on the next line (narrow panels wrap)."""
-    style = imgui.get_style()
-    text = imgui.calc_text_size(label.split("##")[0]).x
-    needed = text + style.item_spacing.x + (
-        imgui.get_frame_height() + style.item_inner_spacing.x if radio
-        else 2 * style.frame_padding.x)
-    last = imgui.get_item_rect_max().x
-    # The cursor is at the start of the next line: its x plus the space left is the right edge.
-    right = imgui.get_cursor_screen_pos().x + imgui.get_content_region_avail().x
-    return last + needed <= right
-
-
 # ---------------------------------------------------------------- per frame
 
 
@@ -293,7 +280,7 @@ def end_frame(viewer) -> None:
     dialogs.draw_discard_question(state)
     drop_stale_overlays(state)
     if state.focus_request:
-        from shadelab.ui.app import focus_windows
+        from shadelab.ui.layout import focus_windows
 
         focus_windows(hello_imgui.get_runner_params().docking_params.dockable_windows,
                       state.focus_request)
