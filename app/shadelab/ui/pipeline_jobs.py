@@ -250,3 +250,28 @@ def _one_spp(scene: Scene) -> Scene:
     scene = clone_scene(scene)
     scene.raytrace.spp = 1
     return scene
+
+
+def warm_pipeline(scene: Scene | None, name: str) -> Iterator[Progress]:
+    """The worker's first task when the viewer starts in an offline pipeline: import that
+    pipeline's renderer and load (or compile) its kernels on an 8x8 image / 24 patches, while
+    the window opens, so the first real job finds them ready. Yields nothing (job id 0)."""
+    from shadelab.scene.preset import load_preset
+
+    try:
+        tiny = clone_scene(scene) if scene is not None else load_preset("cornell")
+        if name == "radiosity":
+            tiny.radiosity.patches = 24
+            tiny.radiosity.solver = "progressive"
+            tiny.radiosity.iterations = 2
+            gen = pipeline_radiosity(tiny, None)
+        elif name == "pathtrace":
+            gen = pipeline_pathtrace(_one_spp(tiny), (8, 8))
+        else:
+            gen = pipeline_raytrace(tiny, (8, 8))
+        for _ in gen:
+            pass
+    except Exception:  # a scene the renderer refuses: its real job reports why
+        pass
+    _RADIOSITY_CACHE.clear()
+    return iter(())

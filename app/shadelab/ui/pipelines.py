@@ -301,7 +301,10 @@ def warm(state: AppState) -> None:
     if runner.worker is not None:
         runner.worker.ensure()   # spawn now: the process imports while the window opens
     if state.pipeline in OFFLINE:
-        return                   # that pipeline's first job is its own warm-up
+        if runner.worker is not None:  # import + load that pipeline's kernels before frame 3
+            runner.worker.tasks.put((0, pipeline_jobs.warm_pipeline, clone_scene(state.scene),
+                                     state.pipeline))
+        return
     scene = clone_scene(state.scene)
     view.name = "warm-up"
     view.record = JobRecord("warm-up", (8, 8), since_start(time.perf_counter()))
