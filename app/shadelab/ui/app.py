@@ -20,7 +20,7 @@ from imgui_bundle import hello_imgui, imgui, immapp
 
 from shadelab.geometry.mesh import geometry_key, scene_meshes
 from shadelab.scene.model import Camera
-from shadelab.ui import gizmos, lesson, overlays, panels, pipelines, presenter
+from shadelab.ui import gizmos, lesson, overlays, panels, pipelines, presenter, radiosity_view
 from shadelab.ui.frame import guarded
 from shadelab.ui.layout import focus_windows
 from shadelab.ui.offline import draw_offline_panel
@@ -695,6 +695,7 @@ def _docking(viewer: Viewer) -> hello_imgui.DockingParams:
         window("Failure gallery", "RightSpace", p(draw_gallery_panel)),
         window("Offline render", "RightBottom", p(draw_offline_panel)),
         window("Algorithms", "LeftSpace", p(draw_algorithms_panel)),
+        window("Hemicube & F", "RightSpace", p(radiosity_view.draw_panel)),
     ]
     for w in params.dockable_windows:
         # llvmpipe is fill-bound: the window clear (same color) replaces every panel's

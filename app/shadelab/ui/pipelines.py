@@ -22,7 +22,7 @@ import numpy as np
 from imgui_bundle import imgui
 
 from shadelab.scene.preset import clone_scene
-from shadelab.ui import pipeline_jobs
+from shadelab.ui import pipeline_jobs, radiosity_view
 from shadelab.ui.state import AppState
 
 PIPELINES = pipeline_jobs.PIPELINE_NAMES
@@ -415,7 +415,7 @@ def _texture(viewer, name: str, size: tuple[int, int], offline: list):
         if view.soup is None or view.name != "radiosity":
             return None
         pane = vp.pane("pipeline_radiosity", size)
-        vp.draw_colored_triangles(pane, state.scene, view.soup)
+        vp.draw_colored_triangles(pane, state.scene, radiosity_view.viewport_soup(state, view.soup))
         if state.show_wireframe or state.radiosity_patches:
             vp.draw_lines(pane, patch_edges(view.soup), exposure)
         if view.shooter is not None and not view.stats.get("done"):
