@@ -1,4 +1,5 @@
-"""An offscreen render target: float RGBA color plus a 24-bit depth / 8-bit stencil buffer.
+"""An offscreen render target: float RGBA color plus a 24-bit depth / 8-bit stencil buffer,
+optionally multisampled (resolved into the color texture with a blit).
 
 moderngl has no stencil API (moderngl#676), so the depth-stencil renderbuffer is made with
 PyOpenGL on moderngl's current context and the framebuffer wrapped by ``detect_framebuffer``.
@@ -39,28 +40,102 @@ def release_framebuffer(ctx: moderngl.Context, *objects) -> None:
         obj.release()
 
 
-class RenderTarget:
-    """Color texture (RGBA32F, linear radiance) + DEPTH24_STENCIL8 renderbuffer."""
+def max_msaa_samples(ctx: moderngl.Context) -> int:
+    """The most samples an RGBA32F + DEPTH24_STENCIL8 multisample target may have here (1:
+    no multisampling; then the viewer falls back to 2x2 supersampling)."""
+    GL = _gl()
+    _ = ctx.error
+    try:
+        counts = [int(GL.glGetIntegerv(GL.GL_MAX_SAMPLES))]
+        for fmt in (GL.GL_RGBA32F, GL.GL_DEPTH24_STENCIL8):
+            counts.append(int(GL.glGetInternalformativ(GL.GL_RENDERBUFFER, fmt, GL.GL_SAMPLES,
+                                                       1)[0]))
+    except Exception:  # no GL 4.2 internal-format query: GL_MAX_SAMPLES alone
+        _ = ctx.error
+        return max(int(getattr(ctx, "max_samples", 1) or 1), 1)
+    return max(min(counts), 1)
 
-    def __init__(self, ctx: moderngl.Context, size: tuple[int, int]):
+
+class RenderTarget:
+    """Color texture (RGBA32F, linear radiance) + DEPTH24_STENCIL8 renderbuffer.
+
+    With ``samples`` > 1 the passes draw into a multisample framebuffer (RGBA32F and
+    DEPTH24_STENCIL8 multisample renderbuffers: stencil shadow volumes keep working per
+    sample) and :meth:`resolve` blits it into ``color``; ``samples`` is clamped to what the GL
+    allows (:func:`max_msaa_samples`), so ``target.samples`` says what was made.
+    """
+
+    def __init__(self, ctx: moderngl.Context, size: tuple[int, int], samples: int = 1):
         GL = _gl()
         _ = ctx.error  # reading the error clears it, so PyOpenGL's checks see only ours
         self.ctx = ctx
         self.size = size
+        self.samples = 1
+        if samples > 1:
+            self.samples = min(int(samples), max_msaa_samples(ctx))
         self.color = ctx.texture(size, 4, dtype="f4")
-        self._renderbuffer = int(GL.glGenRenderbuffers(1))
-        GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, self._renderbuffer)
-        GL.glRenderbufferStorage(GL.GL_RENDERBUFFER, GL.GL_DEPTH24_STENCIL8, *size)
-        self._framebuffer = int(GL.glGenFramebuffers(1))
-        GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, self._framebuffer)
-        GL.glFramebufferTexture2D(GL.GL_FRAMEBUFFER, GL.GL_COLOR_ATTACHMENT0, GL.GL_TEXTURE_2D,
-                                  self.color.glo, 0)
-        GL.glFramebufferRenderbuffer(GL.GL_FRAMEBUFFER, GL.GL_DEPTH_STENCIL_ATTACHMENT,
-                                     GL.GL_RENDERBUFFER, self._renderbuffer)
+        self._renderbuffers: list[int] = []
+        self._framebuffers: list[int] = []
+        self._resolve_fbo = None
+        if self.samples > 1:
+            resolve = self._framebuffer_with(GL, self.color.glo, None)
+            self._resolve_fbo = ctx.detect_framebuffer(resolve)
+            color_rb = self._make_renderbuffer(GL, GL.GL_RGBA32F)
+            depth_rb = self._make_renderbuffer(GL, GL.GL_DEPTH24_STENCIL8)
+            self._framebuffer = self._framebuffer_with(GL, None, depth_rb, color_rb)
+        else:
+            depth_rb = self._make_renderbuffer(GL, GL.GL_DEPTH24_STENCIL8)
+            self._framebuffer = self._framebuffer_with(GL, self.color.glo, depth_rb)
+        self._renderbuffer = depth_rb
+        self.fbo = ctx.detect_framebuffer(self._framebuffer)
+
+    def _make_renderbuffer(self, GL, fmt) -> int:
+        name = int(GL.glGenRenderbuffers(1))
+        self._renderbuffers.append(name)
+        GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, name)
+        if self.samples > 1:
+            GL.glRenderbufferStorageMultisample(GL.GL_RENDERBUFFER, self.samples, fmt,
+                                                *self.size)
+        else:
+            GL.glRenderbufferStorage(GL.GL_RENDERBUFFER, fmt, *self.size)
+        return name
+
+    def _framebuffer_with(self, GL, texture, depth_rb, color_rb=None) -> int:
+        name = int(GL.glGenFramebuffers(1))
+        self._framebuffers.append(name)
+        GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, name)
+        if texture is not None:
+            GL.glFramebufferTexture2D(GL.GL_FRAMEBUFFER, GL.GL_COLOR_ATTACHMENT0,
+                                      GL.GL_TEXTURE_2D, texture, 0)
+        if color_rb is not None:
+            GL.glFramebufferRenderbuffer(GL.GL_FRAMEBUFFER, GL.GL_COLOR_ATTACHMENT0,
+                                         GL.GL_RENDERBUFFER, color_rb)
+        if depth_rb is not None:
+            GL.glFramebufferRenderbuffer(GL.GL_FRAMEBUFFER, GL.GL_DEPTH_STENCIL_ATTACHMENT,
+                                         GL.GL_RENDERBUFFER, depth_rb)
         status = GL.glCheckFramebufferStatus(GL.GL_FRAMEBUFFER)
         if status != GL.GL_FRAMEBUFFER_COMPLETE:
             raise RuntimeError(f"render target incomplete (status 0x{status:x})")
-        self.fbo = ctx.detect_framebuffer(self._framebuffer)
+        return name
+
+    def resolve(self) -> None:
+        """Average the samples into ``color`` (a no-op without multisampling)."""
+        if self._resolve_fbo is None:
+            return
+        GL = _gl()
+        _ = self.ctx.error
+        w, h = self.size
+        GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, self._framebuffers[-1])
+        GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, self._framebuffers[0])
+        GL.glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL.GL_COLOR_BUFFER_BIT, GL.GL_NEAREST)
+        self.fbo.use()  # moderngl's record of the bound framebuffer stays true
+
+    def read_pixel(self, x: int, y: int) -> np.ndarray:
+        """Linear RGB at (x, y), row 0 at the top, after resolving (float32, 3)."""
+        self.resolve()
+        fbo = self._resolve_fbo or self.fbo
+        raw = fbo.read(viewport=(x, self.size[1] - 1 - y, 1, 1), components=3, dtype="f4")
+        return np.frombuffer(raw, dtype=np.float32).copy()
 
     def use(self) -> None:
         self.fbo.use()
@@ -79,6 +154,7 @@ class RenderTarget:
 
     def read(self) -> np.ndarray:
         """Linear RGB (H, W, 3) float32, row 0 at the top."""
+        self.resolve()
         self.ctx.finish()
         w, h = self.size
         data = np.frombuffer(self.color.read(), dtype=np.float32).reshape(h, w, 4)
@@ -94,6 +170,7 @@ class RenderTarget:
 
     def release(self) -> None:
         GL = _gl()
-        release_framebuffer(self.ctx, self.fbo, self.color)
-        GL.glDeleteFramebuffers(1, [self._framebuffer])
-        GL.glDeleteRenderbuffers(1, [self._renderbuffer])
+        release_framebuffer(self.ctx, self.fbo, self.color,
+                            *([self._resolve_fbo] if self._resolve_fbo is not None else []))
+        GL.glDeleteFramebuffers(len(self._framebuffers), self._framebuffers)
+        GL.glDeleteRenderbuffers(len(self._renderbuffers), self._renderbuffers)

@@ -232,6 +232,9 @@ class Viewer:
 
         self.viewport = Viewport(attach_to_current())
         self.state.gl = self.viewport
+        from shadelab.gl.target import max_msaa_samples
+
+        self.state.msaa_limit = max_msaa_samples(self.viewport.ctx)
         from shadelab.ui.dialogs import install_drop_callback
 
         install_drop_callback()
@@ -340,7 +343,8 @@ class Viewer:
         probe_id = s.probe_version
         return (repr(s.scene), size, s.compare, s.diff_enabled, s.diff_pair, s.diff_scale,
                 s.show_wireframe, s.show_normals, s.normal_length, probe_id, s.overlay_version,
-                s.show_radiosity, s.tonemap, s.show_clipping, presenter.line_px(s), s.antialias)
+                s.show_radiosity, s.tonemap, s.show_clipping, presenter.line_px(s), s.antialias,
+                s.msaa)
 
     def unchanged(self, size: tuple[int, int]) -> bool:
         """True when the last image is still right (idle frames only redraw the GUI)."""
@@ -365,10 +369,11 @@ class Viewer:
         # radiosity meshes, Gouraud-interpolated (view-independent: walk around them)
         radiosity = state.show_radiosity and state.radiosity_soup is not None
         if radiosity:
-            pane = vp.pane("main", size)
+            pane = vp.pane("main", size, self.samples())
             vp.draw_colored_triangles(pane, scene, state.radiosity_soup)
         else:
-            pane = vp.draw_scene("main", scene, size, scene.render.shading, scene.render.specular)
+            pane = vp.draw_scene("main", scene, size, scene.render.shading, scene.render.specular,
+                                 self.samples())
         # --- PASS 3: the probe reads the GPU value before any overlay is drawn
         if state.probe_requested:
             self.update_probe(size, display_size)
@@ -393,6 +398,10 @@ class Viewer:
             self.write_viewport_screenshot(state.screenshot_requested)
             state.screenshot_requested = ""
         self._handle_click(self._image_with_input(texture, display_size), display_size)
+
+    def samples(self) -> int:
+        """MSAA samples of the scene pass: the Display panel's choice, within the GL's limit."""
+        return max(1, min(self.state.msaa, self.state.msaa_limit or 1))
 
     def interacting(self) -> bool:
         """A slider or the camera is being dragged right now."""
@@ -463,7 +472,7 @@ class Viewer:
         if "compare3" in vp.panes and self.unchanged(size):
             panes = [vp.panes[f"compare{i}"] for i in range(len(COMPARE_VIEWS))]
         else:
-            panes = [vp.draw_scene(f"compare{i}", scene, half, shading, specular)
+            panes = [vp.draw_scene(f"compare{i}", scene, half, shading, specular, self.samples())
                      for i, (shading, specular) in enumerate(COMPARE_VIEWS)]
         if state.diff_enabled:
             a, b = state.diff_pair

@@ -250,10 +250,7 @@ def draw_display_panel(state: AppState) -> bool:
         if imgui.radio_button(TONEMAP_LABELS[name], state.tonemap == name):
             state.tonemap = name
     _, state.show_clipping = imgui.checkbox("Show clipped pixels (stripes)", state.show_clipping)
-    aa = state.antialias > 1
-    changed, aa = imgui.checkbox("Anti-aliasing (2x2 supersampling)", aa)
-    if changed:
-        state.antialias = 2 if aa else 1
+    draw_antialias_choice(state)
     _, state.show_fps = imgui.checkbox("fps readout", state.show_fps)
     _, state.line_width = imgui.slider_float("line width (0: auto)", state.line_width, 0.0, 8.0,
                                              "%.1f px")
@@ -261,6 +258,25 @@ def draw_display_panel(state: AppState) -> bool:
     _, state.hide_panels = imgui.checkbox("Viewport only (Tab)", state.hide_panels)
     _, state.fullscreen = imgui.checkbox("Fullscreen (F11)", state.fullscreen)
     return False
+
+
+def antialias_choices(limit: int) -> list[tuple[str, int, int]]:
+    """(label, MSAA samples, supersampling factor) the GL allows; without multisampling
+    (``limit`` 1) the 2x2 supersampling is the anti-aliasing offered."""
+    choices = [("off", 1, 1)]
+    choices += [(f"MSAA {n}x", n, 1) for n in (2, 4, 8) if n <= limit]
+    choices.append(("2x2 SSAA", 1, 2))
+    return choices
+
+
+def draw_antialias_choice(state: AppState) -> None:
+    """Anti-aliasing: off, MSAA 2 / 4 / 8 where the GL allows, or 2x2 supersampling."""
+    imgui.text("Anti-aliasing")
+    for label, samples, factor in antialias_choices(state.msaa_limit):
+        if same_line_if_fits(label, radio=True):
+            imgui.same_line()
+        if imgui.radio_button(label, (state.msaa, state.antialias) == (samples, factor)):
+            state.msaa, state.antialias = samples, factor
 
 
 # ---------------------------------------------------------------- per frame

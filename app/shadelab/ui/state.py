@@ -199,6 +199,8 @@ class AppState:
     show_clipping: bool = False       # display: paint clipped pixels
     show_fps: bool = True             # fps / frame-time readout in the viewport
     antialias: int = 1                # supersampling factor of the scene pass (1 or 2)
+    msaa: int = 1                     # MSAA samples of the scene pass (1, 2, 4, 8)
+    msaa_limit: int = 0               # the most the GL allows (0: not known yet)
     line_width: float = 0.0           # overlay lines, pixels (0: by the presenter scale)
     lesson: Any = None                # shadelab.ui.lesson.LessonRun
     pending_open: str = ""            # a file asked for while there are unsaved edits

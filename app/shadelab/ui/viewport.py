@@ -28,6 +28,7 @@ class Pane:
     display: moderngl.Texture
     display_fbo: moderngl.Framebuffer
     view: View | None = None
+    samples_asked: int = 1
 
     @property
     def size(self) -> tuple[int, int]:
@@ -71,27 +72,29 @@ class Viewport:
         (self.ctx.screen or self._anchor).use()
 
     # ------------------------------------------------------------ panes
-    def pane(self, key: str, size: tuple[int, int]) -> Pane:
-        """The pane ``key`` at ``size`` (re-made when the size changes)."""
+    def pane(self, key: str, size: tuple[int, int], samples: int = 1) -> Pane:
+        """The pane ``key`` at ``size`` with ``samples`` MSAA samples (re-made when either
+        changes; ``samples`` beyond the GL's limit get the limit, see ``pane.target.samples``)."""
         size = (max(int(size[0]), 1), max(int(size[1]), 1))
         pane = self.panes.get(key)
-        if pane is not None and pane.size == size:
+        if pane is not None and pane.size == size and pane.samples_asked == samples:
             return pane
         if pane is not None:
             self.restore()
             pane.release()
-        target = RenderTarget(self.ctx, size)
+        target = RenderTarget(self.ctx, size, samples)
         target.color.filter = (moderngl.NEAREST, moderngl.NEAREST)
         display = self.ctx.texture(size, 4, dtype="f1")
         display.filter = (moderngl.LINEAR, moderngl.LINEAR)  # upscaled at render scale < 1
-        pane = Pane(target, display, self.ctx.framebuffer([display]))
+        pane = Pane(target, display, self.ctx.framebuffer([display]), samples_asked=samples)
         self.panes[key] = pane
         return pane
 
     def draw_scene(self, key: str, scene: Scene, size: tuple[int, int], shading: str,
-                   specular: str) -> Pane:
-        """PASS 1-2 (the Renderer): the scene into the pane's float target."""
-        pane = self.pane(key, size)
+                   specular: str, samples: int = 1) -> Pane:
+        """PASS 1-2 (the Renderer): the scene into the pane's float target (``samples``: MSAA,
+        resolved when the pane is presented or read)."""
+        pane = self.pane(key, size, samples)
         pane.view = self.renderer.render(scene, pane.target, shading, specular)
         return pane
 
@@ -149,6 +152,9 @@ class Viewport:
         sRGB of ``source`` (default the pane itself), or the |source - other| heat map when
         ``other`` is given; ``clipping`` stripes the pixels the clamp cuts."""
         source = source or pane
+        source.target.resolve()
+        if other is not None:
+            other.target.resolve()
         pane.display_fbo.use()
         self.ctx.enable_only(moderngl.NOTHING)
         source.target.color.use(0)
@@ -168,12 +174,9 @@ class Viewport:
     # ------------------------------------------------------------ read back
     def read_pixel(self, key: str, pixel: tuple[int, int]) -> np.ndarray:
         """Linear RGB the scene pass drew at (x, y), row 0 at the top (reads one pixel)."""
-        pane = self.panes[key]
-        x, y = pixel
-        raw = pane.target.fbo.read(viewport=(x, pane.size[1] - 1 - y, 1, 1), components=3,
-                                   dtype="f4")
+        value = self.panes[key].target.read_pixel(*pixel)
         self.restore()
-        return np.frombuffer(raw, dtype=np.float32).astype(np.float64)
+        return value.astype(np.float64)
 
     def read_linear(self, key: str) -> np.ndarray:
         return self.panes[key].target.read()
