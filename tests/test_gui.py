@@ -117,10 +117,10 @@ def test_save_reload_broken_file_and_autosave(xdisplay, tmp_path):
     assert r["saved_kd"] == 0.25 and r["reloaded_kd"] == 0.25
     assert r["title_dirty"].endswith("*") and not r["title_saved"].endswith("*")
     assert "bad.toml" in r["broken_error"] and r["kd_after_broken"] == 0.25
-    from shadelab.scene import load_preset
+    from shadelab.ui.session import load_session
 
-    autosaved = load_preset(str(tmp_path / "state" / "shadelab" / "autosave.toml"))
-    assert autosaved.materials["white"].kd == 0.25
+    autosaved = load_session()  # the scenario's state folder (conftest: tmp_path / "state")
+    assert autosaved.note == "" and autosaved.scene.materials["white"].kd == 0.25
 
 
 def test_start_and_cancel_a_job_while_the_ui_keeps_drawing(xdisplay, tmp_path):

@@ -219,11 +219,11 @@ def test_save_as_round_trips_and_clears_the_unsaved_flag(tmp_path):
 def test_autosave_honours_xdg_state_home_and_restores(tmp_path, monkeypatch):
     monkeypatch.setenv("XDG_STATE_HOME", str(tmp_path / "xdg"))
     assert autosave_path() == tmp_path / "xdg" / "shadelab" / "autosave.toml"
-    assert load_session() is None
+    assert not load_session() and load_session().scene is None
     scene = load_preset("cornell")
     scene.lights[0].Ip = (1.0, 2.0, 3.0)
     save_session(scene, "cornell")
-    restored, source = load_session()
+    restored, source = load_session().scene, load_session().source
     assert source == "cornell" and restored.name == "cornell"
     assert restored.base_dir == scene.base_dir
     assert scene_to_dict(restored) == scene_to_dict(scene)

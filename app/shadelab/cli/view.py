@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
 from pathlib import Path
 
 from shadelab.errors import ShadeLabError
@@ -126,19 +127,49 @@ def saved_of(source: str) -> dict:
         return {}
 
 
-def load_scene(args: argparse.Namespace):
-    """(scene, source, restored): the autosaved session if it matches, else the preset."""
+def load_scene(args: argparse.Namespace, notes: list[str] | None = None):
+    """(scene, source, restored): the autosaved session if it matches, else the preset.
+
+    A damaged session never stops the viewer: it is moved aside and what was wrong is
+    appended to ``notes`` (and printed), for the status line."""
     from shadelab.scene.preset import load_preset
     from shadelab.ui.state import load_session
 
     if not args.fresh and not args.set:
         session = load_session()
-        if session is not None and args.preset in (None, session[1]):
-            print(f"shadelab: restored the autosaved session of '{session[1]}' "
+        if session.note:
+            print(f"shadelab: {session.note}", file=sys.stderr)
+            if notes is not None:
+                notes.append(session.note)
+        if session and args.preset in (None, session.source):
+            print(f"shadelab: restored the autosaved session of '{session.source}' "
                   f"(--fresh to start from the preset)")
-            return (*session, True)
+            return session.scene, session.source, True
     name = args.preset or DEFAULT_PRESET
     return load_preset(name, args.set), name, False
+
+
+def _restored_meshes_or_preset(args: argparse.Namespace, scene, source: str,
+                               notes: list[str]):
+    """A restored session whose mesh file no longer reads (damaged since) falls back to the
+    preset, the session kept aside; any other scene's broken mesh is the usual one-line error."""
+    from shadelab.geometry.mesh import scene_meshes
+    from shadelab.ui.session import autosave_path, move_aside
+
+    try:
+        scene_meshes(scene)
+        return scene, source, True
+    except ShadeLabError as exc:
+        copy = move_aside(autosave_path())
+        kept = f"kept as '{copy.name}'" if copy else "could not be moved aside"
+        note = (f"the autosaved session's mesh does not load ({exc}); the session is {kept}; "
+                "started from the preset").replace("\n", " ")
+        print(f"shadelab: {note}", file=sys.stderr)
+        notes.append(note)
+    args.fresh = True
+    scene, source, _ = load_scene(args)
+    scene_meshes(scene)
+    return scene, source, False
 
 
 def run_view(args: argparse.Namespace) -> int:
@@ -163,6 +194,7 @@ def run_view(args: argparse.Namespace) -> int:
             raise ShadeLabError(f"--pipeline '{args.pipeline}': expected one of "
                                 f"{', '.join(PIPELINE_NAMES)}")
     run = None
+    notes: list[str] = []   # a damaged autosaved session, for the status line
     if args.lesson:
         from shadelab.ui.lesson import LessonRun, load_lesson, step_scene
 
@@ -170,10 +202,13 @@ def run_view(args: argparse.Namespace) -> int:
         scene, source, restored = step_scene(run.lesson.steps[0]), \
             run.lesson.steps[0].preset, False
     else:
-        scene, source, restored = load_scene(args)
+        scene, source, restored = load_scene(args, notes)
     from shadelab.geometry.mesh import scene_meshes
 
-    scene_meshes(scene)  # a broken mesh file fails here, with its one-line reason
+    if restored:
+        scene, source, restored = _restored_meshes_or_preset(args, scene, source, notes)
+    else:
+        scene_meshes(scene)  # a broken mesh file fails here, with its one-line reason
     check_display()  # after the input: a bad flag or preset is named even without a display
     from shadelab.ui.app import ViewerOptions, run_viewer
     from shadelab.ui.state import AppState
@@ -184,6 +219,8 @@ def run_view(args: argparse.Namespace) -> int:
         state.saved = saved_of(source)  # the unsaved marker compares with the file, not
         state.dirty = state.saved != scene_to_dict(scene)  # with the restored session
         state.history.files[0] = state.file_meta()
+    if notes:
+        state.error = notes[-1]
     if run is not None:
         from shadelab.ui.lesson import go_to
 

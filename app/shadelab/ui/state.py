@@ -6,8 +6,6 @@ its resources elsewhere (:mod:`shadelab.ui.viewport`).
 
 from __future__ import annotations
 
-import json
-import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -15,6 +13,16 @@ from typing import Any
 from shadelab.errors import ShadeLabError
 from shadelab.scene.model import Scene
 from shadelab.scene.preset import clone_scene, load_preset, save_preset, scene_to_dict
+
+# One file, written atomically; a damaged one is moved aside and never stops the viewer
+# (shadelab.ui.session). Re-exported here, where the viewer has always found them.
+from shadelab.ui.session import (  # noqa: F401
+    SessionLoad,
+    autosave_path,
+    load_session,
+    save_session,
+    state_dir,
+)
 
 COMPARE_VIEWS = (("flat", "phong"), ("gouraud", "phong"), ("phong", "phong"), ("phong", "blinn"))
 COMPARE_LABELS = ("Flat", "Gouraud", "Phong", "Blinn-Phong")
@@ -71,49 +79,6 @@ class History:
             return None
         self.index += 1
         return clone_scene(self.snapshots[self.index])
-
-
-# ---------------------------------------------------------------- autosaved session
-
-
-def state_dir() -> Path:
-    """``$XDG_STATE_HOME/shadelab`` (default ``~/.local/state/shadelab``)."""
-    base = os.environ.get("XDG_STATE_HOME") or str(Path.home() / ".local" / "state")
-    return Path(base) / "shadelab"
-
-
-def autosave_path() -> Path:
-    return state_dir() / "autosave.toml"
-
-
-def save_session(scene: Scene, source: str) -> Path:
-    """Write the scene and where it came from (preset name or file) to the state folder."""
-    folder = state_dir()
-    folder.mkdir(parents=True, exist_ok=True)
-    path = autosave_path()
-    save_preset(scene, path)
-    meta = {"source": source, "name": scene.name, "base_dir": scene.base_dir}
-    meta_path = path.with_suffix(".json")
-    tmp = meta_path.with_name(meta_path.name + ".tmp")
-    tmp.write_text(json.dumps(meta), encoding="utf-8")
-    tmp.replace(meta_path)
-    return path
-
-
-def load_session() -> tuple[Scene, str] | None:
-    """The autosaved scene and its source, or None when there is none (or it is unreadable)."""
-    path = autosave_path()
-    meta_path = path.with_suffix(".json")
-    if not path.is_file() or not meta_path.is_file():
-        return None
-    try:
-        meta = json.loads(meta_path.read_text(encoding="utf-8"))
-        scene = load_preset(str(path))
-    except (ShadeLabError, ValueError, OSError):
-        return None
-    scene.name = meta.get("name", "autosave")
-    scene.base_dir = meta.get("base_dir", scene.base_dir)
-    return scene, meta.get("source", scene.name)
 
 
 # ---------------------------------------------------------------- the app state
