@@ -86,3 +86,11 @@ def test_releasing_a_render_target_leaves_no_gl_error(gl_ctx):
     target.release()
     gl_ctx.simple_framebuffer((4, 4)).release()
     assert gl_ctx.error == "GL_NO_ERROR"
+
+
+def test_warm_compiles_every_offline_renderer(capsys):
+    """`shadelab warm` (run by `make install`) reaches each CPU renderer's kernels."""
+    assert main(["warm"]) == 0
+    err = capsys.readouterr().err
+    for name in ("whitted", "path tracer", "radiosity"):
+        assert f"warmed {name}" in err

@@ -26,6 +26,7 @@ COMMAND_MODULES = (
     "shadelab.cli.studies",
     "shadelab.cli.bench",
     "shadelab.cli.view",
+    "shadelab.cli.warm",
     "shadelab.cli.sweep",
 )
 
