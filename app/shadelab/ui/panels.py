@@ -6,6 +6,8 @@ Panels only read and write :class:`shadelab.ui.state.AppState`; GL work is asked
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from imgui_bundle import imgui, implot
 
@@ -331,6 +333,7 @@ def draw_objects_panel(state: AppState) -> bool:
             if obj.normals == "crease":
                 rows.append(("crease_angle", field_slider(Object)))
             edited |= _edit_fields(obj, rows)
+            edited |= draw_transform(obj, scene_span(state))
             if obj.shape in TESSELLATION_FIELDS:
                 field, lo, hi = TESSELLATION_FIELDS[obj.shape]
                 changed, value = imgui.slider_int(f"tessellation ({field})", getattr(obj, field),
@@ -340,6 +343,31 @@ def draw_objects_panel(state: AppState) -> bool:
                     edited = True
             imgui.tree_pop()
         imgui.pop_id()
+    return edited
+
+
+MIN_SCALE = 1e-3  # a scale of 0 flattens the object into degenerate triangles
+
+
+def draw_transform(obj: Object, span: float) -> bool:
+    """Translate (world units), rotate (XYZ degrees) and scale of ``obj``: drag or Ctrl+click
+    to type; each drag is one undo step (the viewer commits edits when the mouse lets go)."""
+    imgui.separator_text("transform")
+    edited = False
+    changed, value = _vec3("translate", obj.translate, max(span, 1e-6) * 0.002)
+    if changed:
+        obj.translate, edited = value, True
+    changed, value = _vec3("rotate (deg)", obj.rotate, 0.5)
+    if changed:
+        obj.rotate, edited = value, True
+    changed, value = _vec3("scale", obj.scale, 0.005)
+    if changed:
+        obj.scale = tuple(c if abs(c) >= MIN_SCALE else math.copysign(MIN_SCALE, c or 1.0)
+                          for c in value)
+        edited = True
+    if imgui.small_button("reset transform"):
+        obj.translate, obj.rotate, obj.scale = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (1.0, 1.0, 1.0)
+        edited = True
     return edited
 
 
