@@ -13,6 +13,8 @@ offset is visible and testable (shadow acne appears when it is 0).
 
 from __future__ import annotations
 
+import os
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -81,8 +83,57 @@ class Hits:
         return self.tri >= 0
 
 
+SPLIT_RAYS = 16384  # a batch this long or longer is split across threads
+
+
+def accel_threads() -> int:
+    """Threads an Embree batch is split over: the cores this process may run on
+    (``SHADELAB_THREADS`` overrides; 1 traces in the calling thread)."""
+    env = os.environ.get("SHADELAB_THREADS", "")
+    if env.strip().isdigit() and int(env) >= 1:
+        return int(env)
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # not Linux
+        return max(1, os.cpu_count() or 1)
+
+
+_POOL: ThreadPoolExecutor | None = None
+
+
+def _pool() -> ThreadPoolExecutor:
+    global _POOL
+    if _POOL is None:
+        _POOL = ThreadPoolExecutor(max_workers=accel_threads(),
+                                   thread_name_prefix="shadelab-embree")
+    return _POOL
+
+
+def _embree_run(target, o32: np.ndarray, d32: np.ndarray, dists: np.ndarray | None,
+                query: str, output: bool):
+    """``target.run`` over the batch, in slices on the pool's threads where it is long
+    (embreex releases the GIL around its ray loop; each slice is an independent query of the
+    committed scene, so the answer is the same ray for ray)."""
+    n = len(o32)
+    threads = accel_threads()
+    if threads <= 1 or n < SPLIT_RAYS:
+        return target.run(o32, d32, dists=dists, query=query, output=output)
+    bounds = np.linspace(0, n, threads + 1).astype(np.int64)
+    futures = [_pool().submit(target.run, o32[a:b], d32[a:b],
+                              None if dists is None else dists[a:b], query, output)
+               for a, b in zip(bounds[:-1], bounds[1:], strict=True) if b > a]
+    parts = [f.result() for f in futures]
+    if output:
+        return {key: np.concatenate([p[key] for p in parts])
+                for key in ("primID", "u", "v", "tfar")}
+    return np.concatenate(parts)
+
+
 class EmbreeAccel:
-    """Embree 4 through embreex: one scene of all triangles, one of the shadow casters."""
+    """Embree 4 through embreex: one scene of all triangles, one of the shadow casters.
+
+    Long batches are traced on :func:`accel_threads` threads (see :func:`_embree_run`).
+    """
 
     name = "embree"
 
@@ -99,21 +150,32 @@ class EmbreeAccel:
             TriangleMesh(self._all, tris)
         if len(self._caster_ids):
             TriangleMesh(self._casters, tris[self._caster_ids])
+        # Commit both scenes now (embreex commits on the first query), before any threads
+        one = np.zeros((1, 3), np.float32)
+        for scene in (self._all, self._casters):
+            scene.run(one, one + np.float32(1.0), query="OCCLUDED", dists=np.zeros(1, np.float32))
+
+    def intersect_raw(self, origins: np.ndarray, dirs: np.ndarray,
+                      tmax: np.ndarray | None = None):
+        """Closest hits as Embree gives them: tfar (float32), primID (int32, -1 for a miss),
+        u, v (float32); :meth:`intersect` converts these to a :class:`Hits`."""
+        o = np.ascontiguousarray(origins, dtype=np.float32)
+        d = np.ascontiguousarray(dirs, dtype=np.float32)
+        dists = None if tmax is None else np.ascontiguousarray(
+            np.minimum(tmax, T_INF), dtype=np.float32)
+        out = _embree_run(self._all, o, d, dists, "INTERSECT", True)
+        return out["tfar"], out["primID"], out["u"], out["v"]
 
     def intersect(self, origins: np.ndarray, dirs: np.ndarray,
                   tmax: np.ndarray | None = None) -> Hits:
         n = len(origins)
         if n == 0 or self.geometry.count == 0:
             return _misses(n)
-        o = np.ascontiguousarray(origins, dtype=np.float32)
-        d = np.ascontiguousarray(dirs, dtype=np.float32)
-        dists = None if tmax is None else np.ascontiguousarray(
-            np.minimum(tmax, T_INF), dtype=np.float32)
-        out = self._all.run(o, d, dists=dists, output=1)
-        tri = out["primID"].astype(np.int64)
+        tfar, prim, u, v = self.intersect_raw(origins, dirs, tmax)
+        tri = prim.astype(np.int64)
         hit = tri >= 0
-        t = np.where(hit, out["tfar"].astype(np.float64), np.inf)
-        return Hits(t, tri, out["u"].astype(np.float64), out["v"].astype(np.float64))
+        t = np.where(hit, tfar.astype(np.float64), np.inf)
+        return Hits(t, tri, u.astype(np.float64), v.astype(np.float64))
 
     def occluded(self, origins: np.ndarray, dirs: np.ndarray, tmax: np.ndarray,
                  everything: bool = False) -> np.ndarray:
@@ -126,7 +188,7 @@ class EmbreeAccel:
         d = np.ascontiguousarray(dirs, dtype=np.float32)
         dists = np.ascontiguousarray(np.minimum(np.broadcast_to(tmax, (n,)), T_INF),
                                      dtype=np.float32)
-        return target.run(o, d, dists=dists, query="OCCLUDED") != -1
+        return _embree_run(target, o, d, dists, "OCCLUDED", False) != -1
 
 
 def _misses(n: int) -> Hits:
@@ -157,6 +219,12 @@ class BvhAccel:
         t, tri, u, v = self._bvh.intersect(self._all, np.ascontiguousarray(origins, np.float64),
                                            np.ascontiguousarray(dirs, np.float64), limit)
         return Hits(np.where(tri >= 0, t, np.inf), tri, u, v)
+
+    def intersect_raw(self, origins: np.ndarray, dirs: np.ndarray,
+                      tmax: np.ndarray | None = None):
+        """(t, tri, u, v) as :meth:`EmbreeAccel.intersect_raw` (float64 and int64 here)."""
+        hits = self.intersect(origins, dirs, tmax)
+        return hits.t, hits.tri, hits.u, hits.v
 
     def occluded(self, origins: np.ndarray, dirs: np.ndarray, tmax: np.ndarray,
                  everything: bool = False) -> np.ndarray:

@@ -6,9 +6,10 @@ from __future__ import annotations
 
 import time
 
+import numba
 import numpy as np
 
-from shadelab.raytrace.accel import BvhAccel, EmbreeAccel, embree_available, scene_geometry
+from shadelab.raytrace.accel import BvhAccel, accel_threads, embree_available
 from shadelab.raytrace.pathtrace import PathTracer
 from shadelab.raytrace.surface import TraceContext
 from shadelab.raytrace.whitted import iter_raytrace
@@ -17,17 +18,36 @@ from shadelab.scene.preset import load_preset
 from shadelab.timing import median_time
 
 
-def _cpu_ms(fn, repeats: int) -> float:
-    """Median process CPU time of ``fn`` in ms (steadier than wall time on a shared machine)."""
-    samples = []
+def _interleaved(fns: dict, repeats: int, warmup: int = 1) -> dict:
+    """Wall and process-CPU ms of each ``fns`` entry, timed in turn (A B A B ...) so that a
+    shared machine's load falls on all alike; per-round lists kept for paired ratios."""
+    for _ in range(warmup):
+        for fn in fns.values():
+            fn()
+    wall = {name: [] for name in fns}
+    cpu = {name: [] for name in fns}
     for _ in range(repeats):
-        start = time.process_time()
-        fn()
-        samples.append((time.process_time() - start) * 1000.0)
-    return float(np.median(samples))
+        for name, fn in fns.items():
+            start, start_cpu = time.perf_counter(), time.process_time()
+            fn()
+            wall[name].append((time.perf_counter() - start) * 1000.0)
+            cpu[name].append((time.process_time() - start_cpu) * 1000.0)
+    return {name: {"median_ms": float(np.median(wall[name])), "min_ms": min(wall[name]),
+                   "max_ms": max(wall[name]), "repeats": repeats,
+                   "cpu_median_ms": float(np.median(cpu[name])),
+                   "_wall": wall[name], "_cpu": cpu[name]} for name in fns}
 
 
-def _whitted(size: tuple[int, int], repeats: int) -> dict:
+def _paired_ratio(a: dict, b: dict, key: str, work_a: float, work_b: float) -> float:
+    """Median over rounds of (work_a / time_a) / (work_b / time_b)."""
+    pairs = zip(a[key], b[key], strict=True)
+    return float(np.median([(work_a / ta) / (work_b / tb) for ta, tb in pairs]))
+
+
+def _whitted_and_raw(size: tuple[int, int], repeats: int) -> dict:
+    """Whitted (cornell-spheres, depth 5, 1 spp, shading included, the whole image per
+    generation) and the accelerators alone on the same primary rays (float32, no shading),
+    timed interleaved in the same run."""
     scene = load_preset("cornell-spheres")
     start = time.perf_counter()
     ctx = TraceContext(scene)
@@ -35,43 +55,46 @@ def _whitted(size: tuple[int, int], repeats: int) -> dict:
     last = {}
 
     def render():
-        for step in iter_raytrace(scene, size, depth=5, spp=1, ctx=ctx):
+        for step in iter_raytrace(scene, size, depth=5, spp=1, ctx=ctx,
+                                  tile_rays=size[0] * size[1]):
             last["stats"] = step.stats
 
-    timing = median_time(render, repeats, warmup=1)
-    cpu_ms = _cpu_ms(render, repeats)
-    stats = last["stats"]
-    seconds = timing["median_ms"] / 1000.0
-    return {"scene": "cornell-spheres", "size": list(size), "depth": 5, "spp": 1,
-            "backend": ctx.accel.name, "setup_ms": setup_ms, **timing, "cpu_median_ms": cpu_ms,
-            "rays": stats["rays"], "primary_rays": stats["primary_rays"],
-            "secondary_rays": stats["secondary_rays"], "shadow_rays": stats["shadow_rays"],
-            "depth_reached": stats["depth_reached"], "rays_per_s": stats["rays"] / seconds,
-            "rays_per_cpu_s": stats["rays"] / (cpu_ms / 1000.0)}
-
-
-def _raw_primary(size: tuple[int, int], repeats: int) -> dict:
-    """Rays/s of the accelerators alone on the same primary rays (float32, no shading)."""
-    scene = load_preset("cornell-spheres")
-    geometry = scene_geometry(scene)
     o, d = primary_rays(scene.camera, *size)
     o, d = o.reshape(-1, 3), d.reshape(-1, 3)
-    out = {}
-    if embree_available():
-        embree = EmbreeAccel(geometry)
+    fns = {"whitted": render}
+    if embree_available() and ctx.accel.name == "embree":
         o32, d32 = o.astype(np.float32), d.astype(np.float32)
-        def raw():
-            embree._all.run(o32, d32, output=1)  # noqa: SLF001
 
-        timing = median_time(raw, repeats)
-        cpu_ms = _cpu_ms(raw, repeats)
-        out["embree_raw"] = {**timing, "cpu_median_ms": cpu_ms,
-                             "rays_per_s": len(o) / (timing["median_ms"] / 1000.0),
-                             "rays_per_cpu_s": len(o) / (cpu_ms / 1000.0)}
-    bvh = BvhAccel(geometry)
+        def raw():
+            ctx.accel._all.run(o32, d32, output=1)  # noqa: SLF001  (one call, one thread)
+
+        fns["embree_raw"] = raw
+    timed = _interleaved(fns, repeats)
+    stats = last["stats"]
+    w = timed["whitted"]
+    whitted = {"scene": "cornell-spheres", "size": list(size), "depth": 5, "spp": 1,
+               "backend": ctx.accel.name, "threads": accel_threads(),
+               "numba_threads": numba.get_num_threads(), "setup_ms": setup_ms,
+               **{k: v for k, v in w.items() if not k.startswith("_")},
+               "rays": stats["rays"], "primary_rays": stats["primary_rays"],
+               "secondary_rays": stats["secondary_rays"], "shadow_rays": stats["shadow_rays"],
+               "depth_reached": stats["depth_reached"],
+               "rays_per_s": stats["rays"] / (w["median_ms"] / 1000.0),
+               "rays_per_cpu_s": stats["rays"] / (w["cpu_median_ms"] / 1000.0)}
+    raw_out = {}
+    report = {"whitted": whitted, "primary_raw": raw_out}
+    if "embree_raw" in timed:
+        e = timed["embree_raw"]
+        raw_out["embree_raw"] = {**{k: v for k, v in e.items() if not k.startswith("_")},
+                                 "rays_per_s": len(o) / (e["median_ms"] / 1000.0),
+                                 "rays_per_cpu_s": len(o) / (e["cpu_median_ms"] / 1000.0)}
+        # Goal >= 0.7 (issue 13): paired per round, so load drift cancels
+        report["whitted_vs_raw_embree"] = _paired_ratio(w, e, "_wall", stats["rays"], len(o))
+        report["whitted_vs_raw_embree_cpu"] = _paired_ratio(w, e, "_cpu", stats["rays"], len(o))
+    bvh = BvhAccel(ctx.geometry)
     timing = median_time(lambda: bvh.intersect(o, d), max(3, repeats // 2))
-    out["bvh"] = {**timing, "rays_per_s": len(o) / (timing["median_ms"] / 1000.0)}
-    return out
+    raw_out["bvh"] = {**timing, "rays_per_s": len(o) / (timing["median_ms"] / 1000.0)}
+    return report
 
 
 def _pathtrace(size: tuple[int, int], spp: int, repeats: int) -> dict:
@@ -97,15 +120,7 @@ def _pathtrace(size: tuple[int, int], spp: int, repeats: int) -> dict:
 
 def run(quick: bool) -> dict:
     size = (512, 512)
-    repeats = 3 if quick else 7
-    whitted = _whitted(size, repeats)
-    raw = _raw_primary(size, repeats)
-    report = {"whitted": whitted, "primary_raw": raw,
-              "pathtrace": _pathtrace((64, 64) if quick else (128, 128), 4 if quick else 8,
-                                      2 if quick else 5)}
-    if "embree_raw" in raw:
-        # Goal >= 0.5; the CPU-time ratio is the steadier one on a loaded machine
-        report["whitted_vs_raw_embree"] = whitted["rays_per_s"] / raw["embree_raw"]["rays_per_s"]
-        report["whitted_vs_raw_embree_cpu"] = (whitted["rays_per_cpu_s"]
-                                               / raw["embree_raw"]["rays_per_cpu_s"])
+    report = _whitted_and_raw(size, 5 if quick else 9)
+    report["pathtrace"] = _pathtrace((64, 64) if quick else (128, 128), 4 if quick else 8,
+                                     2 if quick else 5)
     return report

@@ -87,20 +87,38 @@ def _power(c, n):
     return 0.0
 
 
+@nb.njit(cache=True, inline="always")
+def _lit(ip, kd, od, lam, ks, os_, spec):
+    """One channel of a light's diffuse + specular term (the same products as reference)."""
+    return ip * kd * od * lam + ip * ks * os_ * spec
+
+
 @nb.njit(cache=True)
 def local_shade(position, normal, to_eye, mat, mats, lights, ia, blinn, shadow):
     """The lecture's I (N, 3) at N points; ``shadow`` is (L, N) S_i."""
+    out = np.empty((len(position), 3))
+    local_shade_into(out, position, normal, to_eye, mat, mats, lights, ia, blinn, shadow, -1.0)
+    return out
+
+
+@nb.njit(cache=True, parallel=True)
+def local_shade_into(out, position, normal, to_eye, mat, mats, lights, ia, blinn, shadow,
+                     eye_sign):
+    """:func:`local_shade` into ``out`` (N, 3); the vector to the eye is ``-eye_sign * to_eye``
+    (pass the ray directions with ``eye_sign = 1``, so no negated copy is made)."""
     n_points = len(position)
-    out = np.empty((n_points, 3))
-    for i in range(n_points):
+    for i in nb.prange(n_points):
         m = mat[i]
         px, py, pz = position[i, 0], position[i, 1], position[i, 2]
         nx, ny, nz = normal[i, 0], normal[i, 1], normal[i, 2]
-        vx, vy, vz = to_eye[i, 0], to_eye[i, 1], to_eye[i, 2]
+        if eye_sign > 0.0:
+            vx, vy, vz = -to_eye[i, 0], -to_eye[i, 1], -to_eye[i, 2]
+        else:
+            vx, vy, vz = to_eye[i, 0], to_eye[i, 1], to_eye[i, 2]
         ka, kd, ks, shininess = mats[m, M_KA], mats[m, M_KD], mats[m, M_KS], mats[m, M_N]
-        r = np.empty(3)
-        for c in range(3):
-            r[c] = mats[m, M_LE + c] + ia[c] * ka * mats[m, M_OD + c]
+        r0 = mats[m, M_LE] + ia[0] * ka * mats[m, M_OD]
+        r1 = mats[m, M_LE + 1] + ia[1] * ka * mats[m, M_OD + 1]
+        r2 = mats[m, M_LE + 2] + ia[2] * ka * mats[m, M_OD + 2]
         for k in range(len(lights)):
             if (kd == 0.0 and ks == 0.0) or shadow[k, i] == 0.0:
                 continue  # adds exactly 0 (mirror, glass, or a shadowed light)
@@ -136,15 +154,15 @@ def local_shade(position, normal, to_eye, mat, mats, lights, ia, blinn, shadow):
                 else:
                     rx, ry, rz = 2.0 * nx * ndl - lx, 2.0 * ny * ndl - ly, 2.0 * nz * ndl - lz
                     spec = _power(rx * vx + ry * vy + rz * vz, shininess)
-            for c in range(3):
-                ip = scale * lights[k, L_IP + c]
-                r[c] += ip * kd * mats[m, M_OD + c] * lam + ip * ks * mats[m, M_OS + c] * spec
-        for c in range(3):
-            out[i, c] = r[c]
-    return out
+            r0 += _lit(scale * lights[k, L_IP], kd, mats[m, M_OD], lam, ks, mats[m, M_OS], spec)
+            r1 += _lit(scale * lights[k, L_IP + 1], kd, mats[m, M_OD + 1], lam, ks,
+                       mats[m, M_OS + 1], spec)
+            r2 += _lit(scale * lights[k, L_IP + 2], kd, mats[m, M_OD + 2], lam, ks,
+                       mats[m, M_OS + 2], spec)
+        out[i, 0], out[i, 1], out[i, 2] = r0, r1, r2
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, parallel=True)
 def surface_frame(origins, dirs, t, tri, u, v, corner_normals, face_normals, object_index):
     """Hit positions, unit shading and geometric normals facing the ray, entering flags."""
     n = len(t)
@@ -153,7 +171,7 @@ def surface_frame(origins, dirs, t, tri, u, v, corner_normals, face_normals, obj
     geo = np.empty((n, 3))
     entering = np.empty(n, np.bool_)
     obj = np.empty(n, np.int64)
-    for i in range(n):
+    for i in nb.prange(n):
         f = tri[i]
         w0 = 1.0 - u[i] - v[i]
         side = 0.0
@@ -172,7 +190,7 @@ def surface_frame(origins, dirs, t, tri, u, v, corner_normals, face_normals, obj
     return position, normal, geo, entering, obj
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, parallel=True)
 def shadow_rays(position, geo, lights, k, eps, t_inf):
     """Origins, directions and tmax of shadow rays to light k, and which points face it."""
     n = len(position)
@@ -180,7 +198,7 @@ def shadow_rays(position, geo, lights, k, eps, t_inf):
     dirs = np.empty((n, 3))
     tmax = np.empty(n)
     facing = np.empty(n, np.bool_)
-    for i in range(n):
+    for i in nb.prange(n):
         lx, ly, lz, dist = _to_light(lights, k, position[i, 0], position[i, 1], position[i, 2])
         facing[i] = geo[i, 0] * lx + geo[i, 1] * ly + geo[i, 2] * lz > 0.0
         dirs[i, 0], dirs[i, 1], dirs[i, 2] = lx, ly, lz
@@ -188,6 +206,85 @@ def shadow_rays(position, geo, lights, k, eps, t_inf):
             origins[i, c] = position[i, c] + eps * geo[i, c]
         tmax[i] = dist - eps if math.isfinite(dist) else t_inf
     return origins, dirs, tmax, facing
+
+
+@nb.njit(cache=True, parallel=True)
+def hit_surfaces(origins, dirs, weight, pixel, t, tri, u, v, hit, corner_normals, face_normals,
+                 object_index, object_material, position, normal, geo, entering, mat, d_hit,
+                 w_hit, p_hit):
+    """:func:`surface_frame` at the rays ``hit`` of a batch, gathered in the same pass.
+
+    ``t``, ``tri``, ``u``, ``v`` as the accelerator gives them (Embree's float32 and int32, or
+    float64 and int64), widened to float64 exactly as ``Hits`` does. Returns position,
+    shading and geometric normals, entering, material index, and the hit rays' directions,
+    weights and pixels, written into the arrays passed (each with len(hit) rows; the caller
+    allocates them, so they can be reused from one generation to the next).
+    """
+    n = len(hit)
+    for j in nb.prange(n):
+        i = hit[j]
+        f = np.int64(tri[i])
+        ti, ui, vi = np.float64(t[i]), np.float64(u[i]), np.float64(v[i])
+        w0 = 1.0 - ui - vi
+        side = 0.0
+        for c in range(3):
+            position[j, c] = origins[i, c] + ti * dirs[i, c]
+            normal[j, c] = (w0 * corner_normals[f, 0, c] + ui * corner_normals[f, 1, c]
+                            + vi * corner_normals[f, 2, c])
+            side += face_normals[f, c] * dirs[i, c]
+            d_hit[j, c] = dirs[i, c]
+            w_hit[j, c] = weight[i, c]
+        length = math.sqrt(normal[j, 0] ** 2 + normal[j, 1] ** 2 + normal[j, 2] ** 2)
+        sign = 1.0 if side < 0.0 else -1.0
+        entering[j] = side < 0.0
+        for c in range(3):
+            normal[j, c] = sign * normal[j, c] / max(length, 1e-300)
+            geo[j, c] = sign * face_normals[f, c]
+        mat[j] = object_material[object_index[f]]
+        p_hit[j] = pixel[i]
+
+
+@nb.njit(cache=True)
+def shadow_batch(position, geo, lights, eps, t_inf, o32, d32, t32, light, point):
+    """:func:`shadow_rays` to every light at once, only where the point faces the light:
+    float32 origins, directions and tmax (as Embree takes them) with the light and point of
+    each ray, written into the arrays passed (N L rows each); returns the count."""
+    n = len(position)
+    n_lights = len(lights)
+    count = 0
+    for i in range(n):
+        for k in range(n_lights):
+            lx, ly, lz, dist = _to_light(lights, k, position[i, 0], position[i, 1],
+                                         position[i, 2])
+            if not geo[i, 0] * lx + geo[i, 1] * ly + geo[i, 2] * lz > 0.0:
+                continue
+            d32[count, 0], d32[count, 1], d32[count, 2] = lx, ly, lz
+            for c in range(3):
+                o32[count, c] = position[i, c] + eps * geo[i, c]
+            t32[count] = min(dist - eps, t_inf) if math.isfinite(dist) else t_inf
+            light[count] = k
+            point[count] = i
+            count += 1
+    return count
+
+
+@nb.njit(cache=True)
+def shadow_matrix(n_lights, n, light, point, blocked):
+    """S_i (L, N): 1 where the point faces light i and nothing blocks it, else 0."""
+    s = np.zeros((n_lights, n))
+    for j in range(len(light)):
+        if not blocked[j]:
+            s[light[j], point[j]] = 1.0
+    return s
+
+
+@nb.njit(cache=True)
+def add_misses(out, pixel, weight, tri, background):
+    """out[pixel[i]] += weight[i] * background where the ray missed (``tri`` < 0)."""
+    for i in range(len(pixel)):
+        if tri[i] < 0:
+            for c in range(3):
+                out[pixel[i], c] += weight[i, c] * background[c]
 
 
 # ---------------------------------------------------------------------- scattering helpers
@@ -271,15 +368,27 @@ def spawn_secondary(position, normal, geo, entering, dirs, mat, weight, pixel, k
     Returns origins, directions, RGB weights and pixel indices of the kept rays.
     """
     n = len(dirs)
-    cap = 2 * n
-    out_o = np.empty((cap, 3))
-    out_d = np.empty((cap, 3))
-    out_w = np.empty((cap, 3))
-    out_p = np.empty(cap, np.int64)
+    out_o = np.empty((2 * n, 3))
+    out_d = np.empty((2 * n, 3))
+    out_w = np.empty((2 * n, 3))
+    out_p = np.empty(2 * n, np.int64)
+    count = spawn_secondary_into(out_o, out_d, out_w, out_p, position, normal, geo, entering,
+                                 dirs, mat, weight, pixel, kr, kt, ior, tint, fresnel,
+                                 min_weight, eps)
+    return out_o[:count], out_d[:count], out_w[:count], out_p[:count]
+
+
+@nb.njit(cache=True)
+def spawn_secondary_into(out_o, out_d, out_w, out_p, position, normal, geo, entering, dirs, mat,
+                         weight, pixel, kr, kt, ior, tint, fresnel, min_weight, eps):
+    """:func:`spawn_secondary` into the arrays passed (2 N rows each); returns the count."""
+    n = len(dirs)
     count = 0
     threshold = max(min_weight, 1e-12)
     for i in range(n):
         m = mat[i]
+        if kr[m] == 0.0 and kt[m] == 0.0:
+            continue  # both weights are 0: nothing to spawn
         dx, dy, dz = dirs[i, 0], dirs[i, 1], dirs[i, 2]
         nx, ny, nz = normal[i, 0], normal[i, 1], normal[i, 2]
         cos_i = min(max(-(dx * nx + dy * ny + dz * nz), 0.0), 1.0)
@@ -304,7 +413,7 @@ def spawn_secondary(position, normal, geo, entering, dirs, mat, weight, pixel, k
             _store_ray(out_o, out_d, out_w, out_p, count, position, geo, i, -1.0, eps,
                        _refract(dx, dy, dz, nx, ny, nz, n1 / n2, cos_i, cos_t), wt, pixel[i])
             count += 1
-    return out_o[:count], out_d[:count], out_w[:count], out_p[:count]
+    return count
 
 
 @nb.njit(cache=True)

@@ -45,6 +45,24 @@ def _unit(v: np.ndarray) -> np.ndarray:
     return v / np.maximum(length, 1e-300)
 
 
+class Workspace:
+    """Scratch arrays kept from one batch to the next, so the kernels write into memory that
+    is already mapped (a fresh array of a few MB costs more in page faults than the loop that
+    fills it). ``get(name, rows, cols, dtype)`` is a view of ``rows`` rows; the next ``get`` of
+    the same name reuses it, so a caller keeps what it needs before asking again."""
+
+    def __init__(self):
+        self._arrays: dict[str, np.ndarray] = {}
+
+    def get(self, name: str, rows: int, cols: int = 0, dtype=np.float64) -> np.ndarray:
+        shape = (rows, cols) if cols else (rows,)
+        have = self._arrays.get(name)
+        if have is None or len(have) < rows or have.dtype != np.dtype(dtype):
+            have = np.empty((max(rows, 1024),) + shape[1:], dtype)
+            self._arrays[name] = have
+        return have[:rows]
+
+
 class TraceContext:
     """A scene prepared for CPU tracing: triangles, accelerator, materials, offset.
 
@@ -79,6 +97,7 @@ class TraceContext:
         self.background = np.asarray(scene.render.background, dtype=np.float64)
         self.specular = scene.render.specular
         self.shadow_rays = 0  # counter, for rays/s figures
+        self.workspace = Workspace()  # the Whitted kernels' scratch (one batch at a time)
         self.material_table = kernels.material_table(self.materials)
         self.light_table = kernels.light_table(self.lights)
         self.Ia = np.asarray(scene.Ia, dtype=np.float64)

@@ -25,7 +25,7 @@ import numpy as np
 from shadelab.errors import ShadeLabError
 from shadelab.progress import Progress
 from shadelab.raytrace import kernels
-from shadelab.raytrace.accel import embree_available
+from shadelab.raytrace.accel import T_INF, embree_available
 from shadelab.raytrace.surface import TraceContext
 from shadelab.scene.model import Scene
 
@@ -93,10 +93,12 @@ def trace_batch(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarray, depth:
                 fresnel: bool, stats: WavefrontStats | None = None,
                 min_weight: float | None = None) -> np.ndarray:
     """Radiance (N, 3) along N rays, recursing to ``depth`` bounces, generation by generation."""
-    n = len(origins)
-    out = np.zeros((n, 3))
     stats = WavefrontStats() if stats is None else stats
     min_weight = ctx.scene.raytrace.min_weight if min_weight is None else min_weight
+    if ctx.kernels:
+        return _trace_batch_kernels(ctx, origins, dirs, depth, fresnel, stats, min_weight)
+    n = len(origins)
+    out = np.zeros((n, 3))
     pixel = np.arange(n)
     weight = np.ones((n, 3))
     shadow_before = ctx.shadow_rays
@@ -128,10 +130,84 @@ def trace_batch(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarray, depth:
     return out
 
 
+def _trace_batch_kernels(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarray,
+                         depth: int, fresnel: bool, stats: WavefrontStats,
+                         min_weight: float) -> np.ndarray:
+    """:func:`trace_batch` with the numba kernels: per generation one closest-hit query, one
+    kernel for the surfaces (gathered at the hits), one occlusion query for every light's
+    shadow rays, the local model and the spawn; no per-ray Python and no fancy indexing.
+    The same sums in the same order as the numpy path (tested to 1e-9)."""
+    n = len(origins)
+    out = np.zeros((n, 3))
+    pixel = np.arange(n)
+    weight = np.ones((n, 3))
+    g = ctx.geometry
+    n_lights = len(ctx.lights)
+    blinn = ctx.specular == "blinn"
+    ws = ctx.workspace
+    for generation in range(depth + 1):
+        if len(origins) == 0:
+            break
+        if generation:
+            stats.secondary += len(origins)
+            stats.depth_reached = max(stats.depth_reached, generation)
+        else:
+            stats.primary += len(origins)
+        if g.count:
+            t, tri, u, v = ctx.accel.intersect_raw(origins, dirs)
+        else:
+            t, tri, u, v = np.full(len(origins), np.inf), np.full(len(origins), -1), None, None
+        # Misses see the background
+        kernels.add_misses(out, pixel, weight, tri, ctx.background)
+        hit = np.flatnonzero(tri >= 0)
+        if generation == 0:
+            stats.primary_hits += len(hit)
+        if len(hit) == 0:
+            break
+        k = len(hit)
+        position, normal = ws.get("position", k, 3), ws.get("normal", k, 3)
+        geo = ws.get("geo", k, 3)
+        d, w, px = ws.get("d", k, 3), ws.get("w", k, 3), ws.get("px", k, 0, np.int64)
+        entering, mat = ws.get("entering", k, 0, np.bool_), ws.get("mat", k, 0, np.int64)
+        kernels.hit_surfaces(origins, dirs, weight, pixel, t, tri, u, v, hit, g.corner_normals,
+                             g.face_normals, g.object_index, ctx.object_material, position,
+                             normal, geo, entering, mat, d, w, px)
+        if not ctx.shadows:
+            shadow = np.ones((n_lights, k))
+        elif n_lights:
+            rows = k * n_lights
+            o32, d32, t32 = (ws.get("so", rows, 3, np.float32), ws.get("sd", rows, 3, np.float32),
+                             ws.get("st", rows, 0, np.float32))
+            light, point = ws.get("sk", rows, 0, np.int64), ws.get("si", rows, 0, np.int64)
+            count = kernels.shadow_batch(position, geo, ctx.light_table, ctx.eps, T_INF, o32,
+                                         d32, t32, light, point)
+            blocked = ctx.accel.occluded(o32[:count], d32[:count], t32[:count])
+            stats.shadow += count
+            ctx.shadow_rays += count
+            shadow = kernels.shadow_matrix(n_lights, k, light[:count], point[:count], blocked)
+        else:
+            shadow = np.zeros((0, k))
+        color = ws.get("color", k, 3)
+        kernels.local_shade_into(color, position, normal, d, mat, ctx.material_table,
+                                 ctx.light_table, ctx.Ia, blinn, shadow, 1.0)
+        kernels.add_weighted(out, px, w, color)
+        if generation == depth:
+            break
+        # Spawn the reflected and refracted generation (into the other set of buffers)
+        new_o, new_d = ws.get("next_o", 2 * k, 3), ws.get("next_d", 2 * k, 3)
+        new_w, new_p = ws.get("next_w", 2 * k, 3), ws.get("next_p", 2 * k, 0, np.int64)
+        count = kernels.spawn_secondary_into(new_o, new_d, new_w, new_p, position, normal, geo,
+                                             entering, d, mat, w, px, ctx.kr, ctx.kt, ctx.ior,
+                                             ctx.tint, fresnel, min_weight, ctx.eps)
+        origins, dirs, weight, pixel = new_o[:count], new_d[:count], new_w[:count], new_p[:count]
+    return out
+
+
 def iter_raytrace(scene: Scene, size: tuple[int, int], depth: int | None = None,
                   spp: int | None = None, fresnel: bool | None = None,
                   backend: str = "auto", shadows: bool = True, seed: int = 0,
-                  ctx: TraceContext | None = None, workers: int = 1) -> Iterator[Progress]:
+                  ctx: TraceContext | None = None, workers: int = 1,
+                  tile_rays: int = TILE_RAYS) -> Iterator[Progress]:
     """Trace the scene progressively: one :class:`Progress` per tile of rows per pass.
 
     Parameters
@@ -146,6 +222,9 @@ def iter_raytrace(scene: Scene, size: tuple[int, int], depth: int | None = None,
     workers : processes tracing tiles in parallel (1: in this process). Each worker
         builds its own context (Embree is single-threaded per process under the GIL);
         closing the generator cancels the tiles not started.
+    tile_rays : primary rays per tile, each traced generation by generation as one batch
+        (the default keeps a tile well under 0.2 s; ``width * height`` traces the whole
+        image per generation, as a batch render without progress does)
 
     Yields
     ------
@@ -159,7 +238,7 @@ def iter_raytrace(scene: Scene, size: tuple[int, int], depth: int | None = None,
     fresnel = settings.fresnel if fresnel is None else bool(fresnel)
     check_settings(depth, spp, size)
     width, height = size
-    rows = max(1, TILE_RAYS // width)
+    rows = max(1, int(tile_rays) // width)
     tiles = [(r, min(r + rows, height)) for r in range(0, height, rows)]
     jobs = [(sample, r0, r1) for sample in range(spp) for r0, r1 in tiles]
     rays = _tile_rays(scene, size, spp, seed)
