@@ -47,3 +47,19 @@ def run_to_end(jobs: Iterator[Progress], desc: str = "", show: bool = True) -> P
     if last is None:
         raise RuntimeError("offline render produced no result")
     return last
+
+
+# ---------------------------------------------------------------- long steps of the CLI
+
+SHOW_STEPS = False      # the CLI turns this on; the viewer and the library stay quiet
+STEP_DELAY_S = 2.0      # a bar appears only for work that has run this long
+
+
+def steps(items, total: int | None = None, desc: str = ""):
+    """``items`` with a tqdm bar on stderr once the loop has run STEP_DELAY_S (CLI only)."""
+    if not SHOW_STEPS:
+        return items
+    from tqdm import tqdm
+
+    return tqdm(items, total=total, desc=desc, delay=STEP_DELAY_S, leave=False,
+                mininterval=0.5, dynamic_ncols=True)

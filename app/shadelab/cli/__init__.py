@@ -72,6 +72,9 @@ def main(argv: list[str] | None = None) -> int:
     saved_term = None
     try:
         args = parser.parse_args(argv)
+        from shadelab import progress
+
+        progress.SHOW_STEPS = True   # steps over ~2 s (validation, meshes) show a bar on stderr
         if getattr(args, "allow_large", False):
             os.environ[ALLOW_ENV] = "1"  # seen by every check, and by worker processes
         if args.command != "view" and threading.current_thread() is threading.main_thread():

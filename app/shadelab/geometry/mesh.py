@@ -19,6 +19,7 @@ from shadelab import limits
 from shadelab.errors import ShadeLabError
 from shadelab.geometry.normals import corner_normals, face_areas, face_normals
 from shadelab.paths import file_problem
+from shadelab.progress import steps
 from shadelab.scene.model import LENGTH_MAX, Object, Scene
 
 MESH_SUFFIXES = (".obj", ".ply", ".stl", ".gltf", ".glb", ".off")
@@ -74,7 +75,7 @@ def scene_meshes(scene: Scene) -> list[MeshData]:
     over it is refused by load_mesh_file before its normals are built)."""
     meshes = []
     total = 0
-    for i, obj in enumerate(scene.objects):
+    for i, obj in steps(enumerate(scene.objects), len(scene.objects), "meshes and normals"):
         meshes.append(object_mesh(obj, i, scene.base_dir))
         total += len(meshes[-1].faces)
         limits.check(f"objects: the scene's first {i + 1} meshes", total, limits.MAX_TRIANGLES,

@@ -20,6 +20,7 @@ import tomli_w
 from shadelab import limits
 from shadelab.errors import ShadeLabError
 from shadelab.paths import OutputSet, file_problem, output_problem, resolve_link
+from shadelab.progress import steps
 from shadelab.resources import presets_dir
 from shadelab.scene.model import (
     MAX_LIGHTS,
@@ -185,8 +186,10 @@ def scene_from_dict(raw: dict, source: str = "<preset>") -> Scene:
             scene.lights = [_build(Light, item, source, f"lights.{i}")
                             for i, item in enumerate(_as_list(value, source, key))]
         elif key == "objects":
+            items = _as_list(value, source, key)
             scene.objects = [_build(Object, item, source, f"objects.{i}")
-                             for i, item in enumerate(_as_list(value, source, key))]
+                             for i, item in steps(enumerate(items), len(items),
+                                                  "validating objects")]
         elif key == "materials":
             if not isinstance(value, dict):
                 raise ShadeLabError(f"{source}: key 'materials': expected a table of materials")
