@@ -142,6 +142,7 @@ class EmbreeAccel:
         from embreex.mesh_construction import TriangleMesh
 
         self.geometry = geometry
+        self._scratch: dict[str, np.ndarray] = {}
         self._all = rtcore_scene.EmbreeScene()
         self._casters = rtcore_scene.EmbreeScene()
         tris = geometry.triangles.astype(np.float32)
@@ -155,12 +156,24 @@ class EmbreeAccel:
         for scene in (self._all, self._casters):
             scene.run(one, one + np.float32(1.0), query="OCCLUDED", dists=np.zeros(1, np.float32))
 
+    def _float32(self, name: str, a: np.ndarray) -> np.ndarray:
+        """``a`` as C-contiguous float32, converted into a buffer kept for the next batch."""
+        if a.dtype == np.float32 and a.flags.c_contiguous:
+            return a
+        buf = self._scratch.get(name)
+        if buf is None or buf.shape[0] < len(a):
+            buf = self._scratch[name] = np.empty((max(len(a), 1024), 3), np.float32)
+        out = buf[:len(a)]
+        np.copyto(out, a, casting="same_kind")
+        return out
+
     def intersect_raw(self, origins: np.ndarray, dirs: np.ndarray,
                       tmax: np.ndarray | None = None):
         """Closest hits as Embree gives them: tfar (float32), primID (int32, -1 for a miss),
-        u, v (float32); :meth:`intersect` converts these to a :class:`Hits`."""
-        o = np.ascontiguousarray(origins, dtype=np.float32)
-        d = np.ascontiguousarray(dirs, dtype=np.float32)
+        u, v (float32); :meth:`intersect` converts these to a :class:`Hits`. Not for two
+        threads at once on one accelerator (the float32 copies of the rays are reused)."""
+        o = self._float32("o", origins)
+        d = self._float32("d", dirs)
         dists = None if tmax is None else np.ascontiguousarray(
             np.minimum(tmax, T_INF), dtype=np.float32)
         out = _embree_run(self._all, o, d, dists, "INTERSECT", True)

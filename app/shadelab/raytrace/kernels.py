@@ -568,6 +568,15 @@ def camera_rays(eye, forward, right, up, tan_half, width, height, r0, r1, jitter
     n = (r1 - r0) * width
     origins = np.empty((n, 3))
     dirs = np.empty((n, 3))
+    camera_rays_into(origins, dirs, eye, forward, right, up, tan_half, width, height, r0, r1,
+                     jitter)
+    return origins, dirs
+
+
+@nb.njit(cache=True)
+def camera_rays_into(origins, dirs, eye, forward, right, up, tan_half, width, height, r0, r1,
+                     jitter):
+    """:func:`camera_rays` into the arrays passed ((r1 - r0) width rows each)."""
     aspect = width / height
     centre = jitter.shape[0] == 0
     for j in range(r0, r1):
@@ -583,7 +592,6 @@ def camera_rays(eye, forward, right, up, tan_half, width, height, r0, r1, jitter
             length = math.sqrt(dx * dx + dy * dy + dz * dz)
             dirs[k, 0], dirs[k, 1], dirs[k, 2] = dx / length, dy / length, dz / length
             origins[k, 0], origins[k, 1], origins[k, 2] = eye[0], eye[1], eye[2]
-    return origins, dirs
 
 
 @nb.njit(cache=True)

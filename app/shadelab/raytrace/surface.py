@@ -62,6 +62,18 @@ class Workspace:
             self._arrays[name] = have
         return have[:rows]
 
+    def constant(self, name: str, rows: int, cols: int, value) -> np.ndarray:
+        """A read-only view of ``rows`` rows filled with ``value`` (an int64 ramp 0, 1, ...
+        for ``value="arange"``), filled again only when it grows."""
+        have = self._arrays.get(name)
+        if have is None or len(have) < rows:
+            size = max(rows, 1024)
+            have = (np.arange(size) if value == "arange"
+                    else np.full((size, cols) if cols else (size,), value, np.float64))
+            have.flags.writeable = False
+            self._arrays[name] = have
+        return have[:rows]
+
 
 class TraceContext:
     """A scene prepared for CPU tracing: triangles, accelerator, materials, offset.

@@ -139,12 +139,12 @@ def _trace_batch_kernels(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarra
     The same sums in the same order as the numpy path (tested to 1e-9)."""
     n = len(origins)
     out = np.zeros((n, 3))
-    pixel = np.arange(n)
-    weight = np.ones((n, 3))
+    ws = ctx.workspace
+    pixel = ws.constant("arange", n, 0, "arange")
+    weight = ws.constant("ones", n, 3, 1.0)
     g = ctx.geometry
     n_lights = len(ctx.lights)
     blinn = ctx.specular == "blinn"
-    ws = ctx.workspace
     for generation in range(depth + 1):
         if len(origins) == 0:
             break
@@ -241,7 +241,7 @@ def iter_raytrace(scene: Scene, size: tuple[int, int], depth: int | None = None,
     rows = max(1, int(tile_rays) // width)
     tiles = [(r, min(r + rows, height)) for r in range(0, height, rows)]
     jobs = [(sample, r0, r1) for sample in range(spp) for r0, r1 in tiles]
-    rays = _tile_rays(scene, size, spp, seed)
+    rays = _tile_rays(scene, size, spp, seed, None if ctx is None else ctx.workspace)
     if workers > 1 and ctx is None and len(jobs) > 1:
         results = _traced_in_pool(scene, backend, shadows, jobs, rays, depth, fresnel, workers)
         name = "embree" if backend == "embree" or (backend == "auto" and embree_available()) \
@@ -251,24 +251,30 @@ def iter_raytrace(scene: Scene, size: tuple[int, int], depth: int | None = None,
         results = _traced_here(ctx, jobs, rays, depth, fresnel)
         name = ctx.accel.name
     stats = WavefrontStats()
-    total = np.zeros((height * width, 3))
-    count = np.zeros(height * width)
+    if spp > 1:
+        total = np.zeros((height * width, 3))
+        count = np.zeros(height * width)
     image = np.zeros((height, width, 3), np.float32)
     start = time.perf_counter()
     for done, ((sample, r0, r1), radiance, tile_stats) in enumerate(results, 1):
         stats.merge(tile_stats)
-        rows_done = slice(r0 * width, r1 * width)
-        total[rows_done] += radiance
-        count[rows_done] += 1
-        image[r0:r1] = (total[rows_done] / count[rows_done, None]).reshape(r1 - r0, width, 3)
-        yield Progress(image.copy(), done / len(jobs),
+        if spp == 1:  # each pixel once: the mean is the sample itself
+            image[r0:r1] = radiance.reshape(r1 - r0, width, 3)
+        else:
+            rows_done = slice(r0 * width, r1 * width)
+            total[rows_done] += radiance
+            count[rows_done] += 1
+            image[r0:r1] = (total[rows_done] / count[rows_done, None]).reshape(r1 - r0, width, 3)
+        last = done == len(jobs)  # the image is not written after the last tile
+        yield Progress(image if last else image.copy(), done / len(jobs),
                        f"pass {sample + 1}/{spp}, rows {r1}/{height}",
                        {**stats.as_dict(name, time.perf_counter() - start), "workers": workers})
 
 
-def _tile_rays(scene: Scene, size: tuple[int, int], spp: int, seed: int):
+def _tile_rays(scene: Scene, size: tuple[int, int], spp: int, seed: int, workspace=None):
     """rays(sample, r0, r1) -> (origins, dirs) of a tile, flattened, as
-    :func:`shadelab.scene.camera.primary_rays` gives them (a numba mirror, per tile)."""
+    :func:`shadelab.scene.camera.primary_rays` gives them (a numba mirror, per tile); with a
+    ``workspace`` the arrays are reused from tile to tile (valid until the next call)."""
     from shadelab.scene.camera import camera_basis  # the camera's own frame, so the images align
 
     width, height = size
@@ -287,8 +293,14 @@ def _tile_rays(scene: Scene, size: tuple[int, int], spp: int, seed: int):
             cache["jitter"] = np.zeros((0, 0, 2)) if jitter is None else jitter
         jitter = cache["jitter"]
         tile = jitter if len(jitter) == 0 else np.ascontiguousarray(jitter[r0:r1])
-        return kernels.camera_rays(eye, forward, right, up, tan_half, width, height, r0, r1,
-                                   tile)
+        n = (r1 - r0) * width
+        if workspace is None:  # numpy's large arrays sit on huge pages: fewer page faults
+            origins, dirs = np.empty((n, 3)), np.empty((n, 3))
+        else:
+            origins, dirs = workspace.get("camera_o", n, 3), workspace.get("camera_d", n, 3)
+        kernels.camera_rays_into(origins, dirs, eye, forward, right, up, tan_half, width,
+                                 height, r0, r1, tile)
+        return origins, dirs
 
     return rays
 
