@@ -129,6 +129,7 @@ def test_start_and_cancel_a_job_while_the_ui_keeps_drawing(xdisplay, tmp_path):
     assert r["frames_while_running"] >= 10      # the UI drew frames while the job worked
     assert r["cancel_latency_s"] < 2.0       # 10 ms chunks: well before the 4 s job ends
     assert r["reference_done"] and r["reference_rmse"] < 1e-4
+    assert r["reference_flip"] is not None and r["reference_flip"] < 1e-3  # FLIP shown too
 
 
 def test_every_panel_and_shortcut_without_errors(xdisplay, tmp_path):
@@ -332,6 +333,7 @@ def scenario_jobs(ctx, state, out: dict) -> None:
           and state.job_version == state.job.snapshot()[1])
     out["reference_done"] = state.job.snapshot()[0].fraction == 1.0
     out["reference_rmse"] = state.job_compare["rmse"]
+    out["reference_flip"] = state.job_compare.get("flip")
 
 
 def scenario_smoke(ctx, state, out: dict) -> None:

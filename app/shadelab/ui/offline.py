@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 from imgui_bundle import imgui
 
@@ -19,6 +21,31 @@ SAMPLES = (1, 4, 16, 64, 256)
 def kinds(state: AppState):
     if state.job_kinds is None:
         state.job_kinds = available_jobs()
+    return state.job_kinds
+
+
+_finder: dict = {}  # the thread looking for the renderers, and what it found
+
+
+def kinds_when_found(state: AppState):
+    """The job kinds, or None while a thread still looks for them: finding them imports
+    every renderer (numba, embree; a second or more), which the first frame must not wait
+    for."""
+    if state.job_kinds is not None:
+        return state.job_kinds
+    thread = _finder.get("thread")
+    if thread is None:
+        def find() -> None:
+            try:
+                _finder["kinds"] = available_jobs()
+            except Exception as exc:  # reported by the synchronous call below
+                _finder["error"] = exc
+        thread = _finder["thread"] = threading.Thread(target=find, name="find-renderers",
+                                                      daemon=True)
+        thread.start()
+    if thread.is_alive():
+        return None
+    state.job_kinds = _finder.get("kinds") or available_jobs()
     return state.job_kinds
 
 
@@ -77,6 +104,10 @@ def _upload_results(state: AppState) -> None:
         scale = max(float(np.abs(raster).max()) * exposure, 1e-6) * 0.1
         vp.upload_image("job_diff", heat_map(image * exposure, raster * exposure, scale))
         state.job_compare = difference(image, raster) | {"heat_full_scale": scale / exposure}
+        if not state.job.running:  # FLIP (~0.1 s at 128^2): once, on the final image
+            from shadelab.studies.metrics import flip
+
+            state.job_compare["flip"] = flip(image, raster, exposure=exposure)
 
 
 def _take_solution(state: AppState, latest) -> None:
@@ -182,7 +213,10 @@ def work_done(latest) -> str:
 
 def draw_offline_panel(state: AppState) -> bool:
     """Pick a renderer, run it off the UI thread, compare its image with the raster view."""
-    job, options = state.job, kinds(state)
+    job, options = state.job, kinds_when_found(state)
+    if options is None:
+        imgui.text_colored(panels.DIM_COLOR, "looking for the offline renderers ...")
+        return False
     labels = [k.label + ("" if k.make else " (not available)") for k in options]
     _, state.job_kind = imgui.combo("Renderer", state.job_kind, labels)
     kind = options[state.job_kind]
@@ -239,6 +273,12 @@ def draw_offline_panel(state: AppState) -> bool:
         c = state.job_compare
         imgui.text(f"RMSE {c['rmse']:.4g}  max |diff| {c['max_abs']:.4g}  "
                    f"relative RMSE {c['relative_rmse']:.3%}")
+        if "flip" in c:
+            imgui.same_line()
+            imgui.text(f"FLIP {c['flip']:.4f}")
+            if imgui.is_item_hovered():
+                imgui.set_tooltip("NVIDIA FLIP: the perceived difference after exposure "
+                                  "(0 = identical, 1 = maximal)")
         imgui.text_colored(panels.DIM_COLOR, f"heat map: red = {c['heat_full_scale']:.3g}")
     if latest is not None and latest.stats and not job.running:
         shown = {k: v for k, v in latest.stats.items()
