@@ -135,6 +135,11 @@ def _check_layout(ctx, state, out: dict) -> None:
     state.presenter = True
     state.probe_pixel, state.probe_requested = (200, 200), True
     ctx.yield_(10)  # fonts, the one-column layout and the probe settle
+    for _ in range(600):  # the Offline panel lists its renderers once a thread found them
+        if state.job_kinds is not None:
+            break
+        ctx.yield_()
+    ctx.yield_(2)
     out["display"] = [int(imgui.get_io().display_size.x), int(imgui.get_io().display_size.y)]
     clipped, checked = [], {}
     for label in DOCK_WINDOWS:

@@ -17,7 +17,7 @@ import time
 from pathlib import Path
 
 WINDOW = "1280x720"
-GOALS = {"fps": 30.0, "first_frame_s": 2.0}  # on llvmpipe, 2 cores
+GOALS = {"fps": 30.0, "first_frame_s": 1.5}  # on llvmpipe, 2 cores (issue 11: first frame 1.5 s)
 NOTE = ("frame_ms: the scene re-rendered every frame at full resolution with every panel drawn; "
         "interactive_frame_ms: the same at the drag-time render scale (0.5, what a slider or "
         "camera drag gets); idle_frame_ms: nothing changed, the GUI alone; first frame counted "
