@@ -92,6 +92,21 @@ def interleaved_ratio(ours, bare, repeats: int) -> dict:
             "repeats": repeats}
 
 
+def hemicube_form_factors(patches: int = 400, resolution: int = 128, repeats: int = 3) -> dict:
+    """Seconds for the full hemicube form-factor matrix of cornell (GPU item buffers, one
+    read-back per batch of patches, one bincount per batch); goal <= 1 s for 400 patches
+    on llvmpipe (issue 13.4). Here, not in the radiosity section: that layer has no GL."""
+    from shadelab.radiosity.formfactors import FormFactors
+    from shadelab.radiosity.patches import uniform_patches
+    from shadelab.render.hemicube import Hemicube
+
+    patch_set = uniform_patches(load_preset("cornell"), patches)
+    timing = median_time(lambda: FormFactors(patch_set, "hemicube", resolution,
+                                             hemicube=Hemicube).matrix(), repeats, warmup=1)
+    return {"patches": len(patch_set), "resolution": resolution, **timing,
+            "seconds": timing["median_ms"] / 1000.0, "goal_s": 1.0}
+
+
 def run(quick: bool) -> dict:
     ctx = headless_context()
     renderer = Renderer(ctx)
@@ -125,5 +140,6 @@ def run(quick: bool) -> dict:
         "cornell_phong_vs_bare_interleaved": paired,
         "cornell_phong_over_bare": paired["ratio"],
         "time_to_first_image_s": time_to_first_image(),
+        "hemicube_form_factors": hemicube_form_factors(repeats=2 if quick else 3),
         "goal": "cornell_phong_over_bare <= 1.3",
     }

@@ -92,6 +92,7 @@ class Hemicube:
         diag = float(max(np.linalg.norm(span), 1e-12))
         self.near, self.far = 1e-4 * diag, 4.0 * diag
         self.weights = self._weight_atlas()
+        self._batch_weights = np.tile(self.weights.ravel(), self.batch)  # a batch's strips
 
     def _weight_atlas(self) -> np.ndarray:
         """Delta form factors laid out like one patch's strip of the atlas (res, 5 res)."""
@@ -115,6 +116,30 @@ class Hemicube:
         for f, forward in enumerate((t, b, -t, -b), start=1):
             yield (f * res, 0, res, res // 2), half @ _view(eye, forward, n)
 
+    def _clip_batch(self, indices: np.ndarray, sample: int) -> np.ndarray:
+        """(len, 5, 4, 4) float32 ``clip_from_world.T`` of the faces of :meth:`_faces`, for
+        all the patches at once (numpy over the batch instead of per face)."""
+        n = self.patches.normals[indices]
+        helper = np.where((np.abs(n[:, 0]) < 0.9)[:, None], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
+        t = np.cross(helper, n)
+        t /= np.linalg.norm(t, axis=1, keepdims=True)
+        b = np.cross(n, t)
+        eye = self.eyes[indices, sample] + n * self.near * 2.0
+        nr, fr = self.near, self.far
+        # (forward, up) of the five faces: top along n (up b), sides along t, b, -t, -b (up n)
+        forward = np.stack([n, t, b, -t, -b], axis=1)
+        up = np.stack([b, n, n, n, n], axis=1)
+        right = np.cross(forward, up)
+        view = np.zeros((len(indices), 5, 4, 4))
+        view[..., 0, :3], view[..., 1, :3], view[..., 2, :3] = right, up, -forward
+        view[..., :3, 3] = -np.einsum("fij,fj->fi", view[..., :3, :3].reshape(-1, 3, 3),
+                                      np.repeat(eye, 5, axis=0)).reshape(len(indices), 5, 3)
+        view[..., 3, 3] = 1.0
+        top, half = _frustum(-nr, nr, -nr, nr, nr, fr), _frustum(-nr, nr, 0.0, nr, nr, fr)
+        proj = np.stack([top, half, half, half, half])
+        clip = proj[None] @ view
+        return np.ascontiguousarray(np.swapaxes(clip, -1, -2), dtype=np.float32)
+
     def item_atlas(self, indices: np.ndarray, sample: int = 0) -> np.ndarray:
         """Item ids (len, res, 5 res) uint32 (id + 1, 0 = nothing) for up to ``batch`` patches
         (their hemicube number ``sample``).
@@ -126,17 +151,24 @@ class Hemicube:
         self.fbo.use()
         self.fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         ctx.enable_only(moderngl.DEPTH_TEST)
-        for slot, i in enumerate(indices):
+        clips = self._clip_batch(np.asarray(indices, np.int64), sample)
+        uniform = self.program["u_clip_from_world"]
+        boxes = [(0, 0, res, res)] + [(f * res, 0, res, res // 2) for f in range(1, 5)]
+        for slot in range(len(indices)):
             base_y = (self.batch - 1 - slot) * res  # slot 0 at the top after the row flip
-            for (x, y, w, h), clip in self._faces(int(i), sample):
+            for face, (x, y, w, h) in enumerate(boxes):
                 self.fbo.viewport = (x, base_y + y, w, h)
-                self.program["u_clip_from_world"].write(clip.T.astype("f4").tobytes())
+                uniform.write(clips[slot, face])
                 self.vao.render(moderngl.TRIANGLES)
         self.fbo.viewport = (0, 0, *self.fbo.size)
-        raw = np.frombuffer(self.color.read(alignment=1), dtype=np.uint32)
+        # One read-back per batch, of the slots drawn only (they are the atlas's top rows)
+        used = len(indices) * res
+        raw = np.frombuffer(self.fbo.read(viewport=(0, self.batch * res - used, 5 * res, used),
+                                          components=1, dtype="u4", alignment=1),
+                            dtype=np.uint32)
         rebind(ctx, previous)
-        atlas = raw.reshape(self.batch * res, 5 * res)[::-1]
-        return atlas.reshape(self.batch, res, 5 * res)[:len(indices)]
+        atlas = raw.reshape(used, 5 * res)[::-1]
+        return atlas.reshape(len(indices), res, 5 * res)
 
     def rows(self, indices: np.ndarray) -> np.ndarray:
         """Form-factor rows (len(indices), N): delta form factors summed per item."""
@@ -146,10 +178,13 @@ class Hemicube:
             part = indices[start:start + self.batch]
             for sample in range(self.eyes.shape[1]):
                 atlas = self.item_atlas(part, sample)
-                for k, i in enumerate(part):
-                    sums = np.bincount(atlas[k].ravel(), weights=self.weights.ravel(),
-                                       minlength=n + 1)
-                    out[start + k] += self.eye_w[i, sample] * sums[1:n + 1]
+                # One bincount for the batch: patch k's items offset by k (N + 1)
+                keys = atlas.reshape(len(part), -1).astype(np.int64)
+                keys += (np.arange(len(part)) * (n + 1))[:, None]
+                weights = self._batch_weights[:keys.size]
+                sums = np.bincount(keys.ravel(), weights=weights,
+                                   minlength=len(part) * (n + 1)).reshape(len(part), n + 1)
+                out[start:start + len(part)] += self.eye_w[part, sample][:, None] * sums[:, 1:]
             out[np.arange(start, start + len(part)), part] = 0.0
         return out
 
