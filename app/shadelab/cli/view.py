@@ -54,6 +54,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                         "radiosity, raytrace, pathtrace")
     p.add_argument("--presenter", action="store_true", help="large fonts for a projector")
     p.add_argument("--wireframe", action="store_true", help="show the wireframe")
+    p.add_argument("--msaa", type=int, choices=(1, 2, 4, 8), default=1, metavar="N",
+                   help="MSAA samples of the scene pass (1, 2, 4, 8; capped at what the GL "
+                        "allows; the Display panel changes it)")
     p.add_argument("--normals", action="store_true", help="show normal glyphs")
     p.add_argument("--help-overlay", action="store_true", help="show the shortcut help")
     p.add_argument("--no-autosave", action="store_true", help="do not write the session")
@@ -229,6 +232,7 @@ def run_view(args: argparse.Namespace) -> int:
     state.compare, state.diff_enabled = args.compare, args.diff
     state.presenter, state.show_help = args.presenter, args.help_overlay
     state.show_wireframe, state.show_normals = args.wireframe, args.normals
+    state.msaa = args.msaa
     options = ViewerOptions(frames=args.frames, screenshot=args.screenshot or "",
                             window_size=window, probe=probe, job=args.job or "",
                             bench_json=args.bench_json or "", autosave=not args.no_autosave,

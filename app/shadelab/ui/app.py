@@ -457,7 +457,12 @@ class Viewer:
         state.probe_requested = False
         result = probe(state.scene, size, pixel)
         if result is not None and not state.show_radiosity:
-            result.gpu = self.viewport.read_pixel("main", pixel)
+            key = "main"
+            if self.samples() > 1:  # a resolved edge pixel averages both sides: read 1 sample
+                key = "probe"
+                self.viewport.draw_scene(key, state.scene, size, state.scene.render.shading,
+                                         state.scene.render.specular)
+            result.gpu = self.viewport.read_pixel(key, pixel)
         state.probe = result
         state.probe_version += 1
         if result is None:
