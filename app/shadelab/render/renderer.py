@@ -171,12 +171,14 @@ class Renderer:
         return program_name
 
     def set_frame_uniforms(self, program: moderngl.Program, scene: Scene, view: View,
-                           specular: str) -> None:
+                           specular: str, lights: list[Light] | None = None) -> None:
+        """Camera, ambient, specular model and the lights (the scene's active ones unless
+        ``lights`` is given, as the shadow passes do one light at a time)."""
         set_uniform(program, "u_clip_from_world", gl_matrix(view.clip_from_world))
         set_uniform(program, "u_eye", tuple(view.eye))
         set_uniform(program, "u_Ia", tuple(scene.Ia))
         set_uniform(program, "u_specular_model", SPECULAR_CODES[specular])
-        write_light_uniforms(program, scene.active_lights())
+        write_light_uniforms(program, scene.active_lights() if lights is None else lights)
 
     @staticmethod
     def set_material_uniforms(program: moderngl.Program, material: Material) -> None:
@@ -228,7 +230,8 @@ class Renderer:
         # --- PASS 3: per light, a stencil count of its shadow volumes (z-fail or z-pass),
         #     then that light alone added where the count is 0 (S_i = 1), nowhere else
         if shadowed:
-            self._shadow_passes(scene, target, view, gpu_meshes, opaque, lights, shading)
+            self._shadow_passes(scene, target, view, gpu_meshes, opaque, lights, shading,
+                                specular)
         # --- PASS 4: transparent surfaces back to front, blended by their model
         #     (interpolated or filtered), depth-tested against the opaque ones
         if clear:
@@ -253,11 +256,12 @@ class Renderer:
         return self._shadows
 
     def _shadow_passes(self, scene: Scene, target: RenderTarget, view: View, gpu_meshes,
-                       opaque, lights: list[Light], shading: str) -> None:
+                       opaque, lights: list[Light], shading: str, specular: str) -> None:
+        """Per light: count its volumes in the stencil, then add that light alone where the
+        count is 0, with the program variant compiled for that one light (the others would
+        be evaluated and multiplied by S_i = 0: the same sum, m times the shading work)."""
         shadows = self.shadow_volumes
         shadows.drop_lights_from(len(lights))
-        for variant in self.variants(shading):
-            set_uniform(variant, "u_ambient_on", 0.0)
         for index, light in enumerate(lights):
             volumes = shadows.volumes(scene, gpu_meshes, index, light)
             shadows.count(target, view, volumes, scene.render.shadow_method)
@@ -265,11 +269,13 @@ class Renderer:
             self.ctx.blend_func = moderngl.ONE, moderngl.ONE
             self.ctx.depth_func = "<="
             shadows.lit_where_zero()
+            self.use_lights([light], specular)
             for variant in self.variants(shading):
-                write_light_uniforms(variant, lights,
-                                     shadow=[float(j == index) for j in range(len(lights))])
+                self.set_frame_uniforms(variant, scene, view, specular, [light])
+                set_uniform(variant, "u_ambient_on", 0.0)
             self.draw_objects(scene, opaque, shading)
         shadows.stencil_off()
+        self.use_lights(lights, specular)
         self.ctx.depth_func = "<"
         self.ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA  # the default
         target.fbo.depth_mask = True
