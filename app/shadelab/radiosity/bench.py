@@ -108,6 +108,35 @@ def first_lit_image(scene, size, patches: int, repeats: int = 3) -> dict:
             "size": list(size)}
 
 
+def radiosity_scaling(scene, quick: bool) -> dict:
+    """Seconds against patch count, form factors (ray-cast matrix) and the solve (Gauss-
+    Seidel) apart, each with its fitted exponent (expected ~2 for both: N^2 pairs, N^2 per
+    sweep)."""
+    from shadelab.radiosity.formfactors import FormFactors
+    from shadelab.radiosity.patches import uniform_patches
+    from shadelab.radiosity.solvers import solve_gauss_seidel
+    from shadelab.timing import scaling
+
+    counts = (100, 200, 400) if quick else (100, 200, 400, 800, 1600)
+    patches, ff_s, solve_s = [], [], []
+    warm = uniform_patches(scene, 50)  # numba kernels loaded before the first timed point
+    for _ in solve_gauss_seidel(FormFactors(warm, "raycast").matrix(), warm.rho, warm.emission):
+        pass
+    for count in counts:
+        p = uniform_patches(scene, count)
+        start = time.perf_counter()
+        F = FormFactors(p, "raycast").matrix()
+        ff_s.append(time.perf_counter() - start)
+        E = np.pi * p.emission
+        start = time.perf_counter()
+        for _ in solve_gauss_seidel(F, p.rho, E):
+            pass
+        solve_s.append(time.perf_counter() - start)
+        patches.append(len(p))
+    return {"form_factors": scaling(patches, ff_s, "patches"),
+            "solve_gauss_seidel": scaling(patches, solve_s, "patches")}
+
+
 def run(quick: bool) -> dict:
     """Bench figures for cornell (quick: 16x16 comparisons, fewer samples)."""
     from shadelab.raytrace.pathtrace import render_pathtraced
@@ -152,4 +181,5 @@ def run(quick: bool) -> dict:
         "speedup_radiosity_vs_pathtracer": ratio, "speedup_goal": 3.0,
         "projected_512": projected,
         "first_lit_image_progressive": first, "first_lit_image_goal_s": 0.5,
+        "scaling_vs_patches": radiosity_scaling(scene, quick),
     }

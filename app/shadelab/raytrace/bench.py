@@ -118,9 +118,37 @@ def _pathtrace(size: tuple[int, int], spp: int, repeats: int) -> dict:
             "backend": tracer.ctx.accel.name}
 
 
+def whitted_scaling(quick: bool) -> dict:
+    """Whitted seconds on cornell-spheres against pixels (depth 5) and against depth
+    (at 128 x 128), each with its fitted exponent (depth: against depth + 1 generations)."""
+    from shadelab.timing import scaling
+
+    scene = load_preset("cornell-spheres")
+    ctx = TraceContext(scene)
+
+    def seconds(size, depth):
+        def render():
+            for _ in iter_raytrace(scene, size, depth=depth, spp=1, ctx=ctx,
+                                   tile_rays=size[0] * size[1]):
+                pass
+
+        return median_time(render, 3, warmup=1)["median_ms"] / 1000.0
+
+    sides = (64, 128, 256) if quick else (64, 128, 256, 512)
+    pixels = [side * side for side in sides]
+    by_pixels = [seconds((side, side), 5) for side in sides]
+    depths = (0, 1, 2, 3, 5) if quick else (0, 1, 2, 3, 4, 5, 8)
+    by_depth = [seconds((128, 128), depth) for depth in depths]
+    out = {"vs_pixels": scaling(pixels, by_pixels, "pixels"),
+           "vs_depth": scaling([d + 1 for d in depths], by_depth, "generations")}
+    out["vs_depth"]["depths"] = list(depths)
+    return out
+
+
 def run(quick: bool) -> dict:
     size = (512, 512)
     report = _whitted_and_raw(size, 5 if quick else 9)
+    report["scaling_whitted"] = whitted_scaling(quick)
     report["pathtrace"] = _pathtrace((64, 64) if quick else (128, 128), 4 if quick else 8,
                                      2 if quick else 5)
     return report

@@ -3,6 +3,7 @@ moderngl per-fragment Phong draw of the same triangles for a noise-proof ratio."
 
 from __future__ import annotations
 
+import dataclasses
 import statistics
 import time
 
@@ -16,7 +17,7 @@ from shadelab.gl.target import RenderTarget, release_framebuffer
 from shadelab.render.renderer import Renderer, make_view, triangle_soup
 from shadelab.scene.camera import gl_matrix
 from shadelab.scene.preset import list_presets, load_preset
-from shadelab.timing import median_time
+from shadelab.timing import median_time, scaling
 
 SIZE = (800, 600)
 
@@ -107,6 +108,28 @@ def hemicube_form_factors(patches: int = 400, resolution: int = 128, repeats: in
             "seconds": timing["median_ms"] / 1000.0, "goal_s": 1.0}
 
 
+def raster_scaling(renderer: Renderer, target: RenderTarget, quick: bool) -> dict:
+    """Phong frame time against triangle count: icospheres (20 * 4^k triangles) of
+    sphere-shading, up to three of them for ~1M triangles (--quick: up to ~80k)."""
+    ctx = renderer.ctx
+    levels = [(3, 1), (4, 1), (5, 1), (6, 1)] if quick else [(3, 1), (4, 1), (5, 1), (6, 1),
+                                                             (7, 1), (7, 3)]
+    counts, seconds = [], []
+    for level, copies in levels:
+        scene = load_preset("sphere-shading", [f"objects.0.subdivisions={level}"])
+        for k in range(1, copies):
+            scene.objects.append(dataclasses.replace(scene.objects[0], name=f"sphere{k}"))
+
+        def frame(scene=scene):
+            renderer.render(scene, target, "phong")
+            ctx.finish()
+
+        timing = median_time(frame, 3 if quick else 5)
+        counts.append(sum(len(m.faces) for m in scene_meshes(scene)))
+        seconds.append(timing["median_ms"] / 1000.0)
+    return scaling(counts, seconds, "triangles")
+
+
 def run(quick: bool) -> dict:
     ctx = headless_context()
     renderer = Renderer(ctx)
@@ -131,6 +154,7 @@ def run(quick: bool) -> dict:
 
     paired = interleaved_ratio(ours, bare, 2 * repeats)
     release_bare()
+    scaling_figure = raster_scaling(renderer, target, quick)
     renderer.release()
     target.release()
     return {
@@ -141,5 +165,6 @@ def run(quick: bool) -> dict:
         "cornell_phong_over_bare": paired["ratio"],
         "time_to_first_image_s": time_to_first_image(),
         "hemicube_form_factors": hemicube_form_factors(repeats=2 if quick else 3),
+        "scaling_frame_vs_triangles": scaling_figure,
         "goal": "cornell_phong_over_bare <= 1.3",
     }
