@@ -118,6 +118,61 @@ def _pathtrace(size: tuple[int, int], spp: int, repeats: int) -> dict:
             "backend": tracer.ctx.accel.name}
 
 
+def _mitsuba(size, spp: int, repeats: int) -> dict:
+    """Mitsuba 3's ``path`` integrator (NEE + MIS + Russian roulette, max_depth -1) on the
+    same Cornell box: our preset's triangles, diffuse reflectances kd * Od, the emitter's
+    radiance and our camera, on the ``llvm_ad_rgb`` variant; samples/s in the same run.
+    Mitsuba only where the optional ``bench`` extra is installed (and libLLVM for Dr.Jit)."""
+    try:
+        import drjit as dr
+        import mitsuba as mi
+
+        mi.set_variant("llvm_ad_rgb")
+    except Exception as exc:  # not installed, or Dr.Jit found no LLVM
+        return {"available": False, "why": f"{type(exc).__name__}: {exc}"[:300]}
+    from shadelab.geometry.mesh import scene_meshes
+
+    scene = load_preset("cornell")
+    shapes = {}
+    for m in scene_meshes(scene):
+        material = scene.materials[m.material]
+        props = mi.Properties()
+        rho = [material.kd * c for c in material.Od]
+        props["bsdf"] = mi.load_dict({"type": "diffuse", "reflectance": {
+            "type": "rgb", "value": rho}})
+        if max(material.emission) > 0.0:
+            props["emitter"] = mi.load_dict({"type": "area", "radiance": {
+                "type": "rgb", "value": list(material.emission)}})
+        mesh = mi.Mesh(f"m{m.index}", len(m.vertices), len(m.faces), props=props)
+        params = mi.traverse(mesh)
+        params["vertex_positions"] = dr.ravel(mi.TensorXf(m.vertices.astype(np.float32)))
+        params["faces"] = dr.ravel(mi.TensorXu(m.faces.astype(np.uint32)))
+        params.update()
+        shapes[f"m{m.index}"] = mesh
+    cam = scene.camera
+    width, height = size
+    mscene = mi.load_dict({
+        "type": "scene", "integrator": {"type": "path", "max_depth": -1, "rr_depth": 5},
+        "sensor": {"type": "perspective", "fov": cam.fov_y, "fov_axis": "y",
+                   "to_world": mi.ScalarTransform4f().look_at(origin=list(cam.eye),
+                                                              target=list(cam.target),
+                                                              up=list(cam.up)),
+                   "film": {"type": "hdrfilm", "width": width, "height": height,
+                            "rfilter": {"type": "box"}},
+                   "sampler": {"type": "independent", "sample_count": spp}},
+        **shapes})
+
+    def render():
+        dr.eval(mi.render(mscene, spp=spp))
+
+    timing = median_time(render, repeats, warmup=1)
+    samples = width * height * spp
+    return {"available": True, "scene": "cornell (our triangles, kd Od, Le, camera)",
+            "variant": "llvm_ad_rgb", "integrator": "path (NEE + MIS + RR)",
+            "size": list(size), "spp": spp, **timing, "version": mi.__version__,
+            "samples_per_s": samples / (timing["median_ms"] / 1000.0)}
+
+
 def whitted_scaling(quick: bool) -> dict:
     """Whitted seconds on cornell-spheres against pixels (depth 5) and against depth
     (at 128 x 128), each with its fitted exponent (depth: against depth + 1 generations)."""
@@ -149,6 +204,15 @@ def run(quick: bool) -> dict:
     size = (512, 512)
     report = _whitted_and_raw(size, 5 if quick else 9)
     report["scaling_whitted"] = whitted_scaling(quick)
-    report["pathtrace"] = _pathtrace((64, 64) if quick else (128, 128), 4 if quick else 8,
-                                     2 if quick else 5)
+    pt_size, pt_spp, pt_repeats = (64, 64) if quick else (128, 128), 4 if quick else 8, \
+        2 if quick else 5
+    report["pathtrace"] = _pathtrace(pt_size, pt_spp, pt_repeats)
+    report["mitsuba_path"] = _mitsuba(pt_size, pt_spp, pt_repeats)
+    if report["mitsuba_path"]["available"]:  # goal >= 0.7 (issue 13.3)
+        report["pathtrace_vs_mitsuba"] = (report["pathtrace"]["samples_per_s"]
+                                          / report["mitsuba_path"]["samples_per_s"])
+    else:
+        report["pathtrace_vs_mitsuba"] = None
+        report["pathtrace_vs_mitsuba_why"] = ("mitsuba not available here: "
+                                              + report["mitsuba_path"]["why"])
     return report
