@@ -1,6 +1,7 @@
 """Tiles of an offline render traced by worker processes (both cores), in job order.
 
-Embree holds the GIL in ``embreex``, so threads do not help; processes do. Workers are
+A single process already uses both cores (embreex releases the GIL and the hot numba
+kernels run in ``prange``); processes are the opt-in alternative (``--workers``). Workers are
 spawned (no fork of a process that may hold GL or Embree threads) and each builds its own
 scene context once, in ``init``. A few tiles are in flight at a time; closing the consuming
 generator cancels the tiles not started.
