@@ -124,7 +124,7 @@ def _shadow_nodes(ctx: TraceContext, surf, shadow: list, weight: np.ndarray,
     for i, light in enumerate(ctx.lights):
         to_light, distance = light_vectors(light, surf.position)
         start = surf.position[0] + ctx.eps * surf.geo_normal[0]
-        lit = float(shadow[i][0])
+        lit = float(np.max(shadow[i][0]))  # S_i, or its largest channel (kt-filtered)
         end = None if light.kind == "directional" else np.asarray(light.position, float)
         blocker = -1
         if lit == 0.0:  # blocked, or the light is behind the surface: find the blocker

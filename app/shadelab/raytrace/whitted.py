@@ -130,6 +130,17 @@ def trace_batch(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarray, depth:
     return out
 
 
+def _shade_per_channel(ctx: TraceContext, color, position, normal, d, mat, blinn: bool,
+                       shadow: np.ndarray) -> None:
+    """:func:`kernels.local_shade_into` with kt-filtered S_i (L, k, 3): a pass per channel."""
+    def shade_one(s):
+        one = ctx.workspace.get("color_c", len(mat), 3)
+        kernels.local_shade_into(one, position, normal, d, mat, ctx.material_table,
+                                 ctx.light_table, ctx.Ia, blinn, s, 1.0)
+        return one
+    ctx.local_per_channel(shade_one, shadow, color)
+
+
 def _trace_batch_kernels(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarray,
                          depth: int, fresnel: bool, stats: WavefrontStats,
                          min_weight: float) -> np.ndarray:
@@ -185,11 +196,18 @@ def _trace_batch_kernels(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarra
             stats.shadow += count
             ctx.shadow_rays += count
             shadow = kernels.shadow_matrix(n_lights, k, light[:count], point[:count], blocked)
+            if ctx.transparent_casters:  # kt-filtered S_i (L, k, 3)
+                shadow = ctx.filtered_shadow_matrix(shadow, light[:count], point[:count],
+                                                    blocked, o32[:count], d32[:count],
+                                                    t32[:count])
         else:
             shadow = np.zeros((0, k))
         color = ws.get("color", k, 3)
-        kernels.local_shade_into(color, position, normal, d, mat, ctx.material_table,
-                                 ctx.light_table, ctx.Ia, blinn, shadow, 1.0)
+        if shadow.ndim == 3:
+            _shade_per_channel(ctx, color, position, normal, d, mat, blinn, shadow)
+        else:
+            kernels.local_shade_into(color, position, normal, d, mat, ctx.material_table,
+                                     ctx.light_table, ctx.Ia, blinn, shadow, 1.0)
         kernels.add_weighted(out, px, w, color)
         if generation == depth:
             break
