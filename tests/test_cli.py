@@ -94,3 +94,27 @@ def test_warm_compiles_every_offline_renderer(capsys):
     err = capsys.readouterr().err
     for name in ("whitted", "path tracer", "radiosity"):
         assert f"warmed {name}" in err
+
+
+@pytest.mark.parametrize("kind, code", [(KeyboardInterrupt, 130), (SystemExit, None)])
+def test_ctrl_c_inside_a_numba_kernel_is_an_interrupt(monkeypatch, capsys, kind, code):
+    """A Ctrl+C landing inside a numba kernel surfaces as SystemErrors around the
+    KeyboardInterrupt: still exit 130 and one line; any other SystemError propagates."""
+    import shadelab.cli.render as render_cli
+
+    def interrupted(args):
+        try:
+            raise kind()
+        except BaseException as inner:
+            try:
+                raise SystemError("returned a result with an exception set") from inner
+            except SystemError as outer:
+                raise SystemError("returned a result with an exception set") from outer
+
+    monkeypatch.setattr(render_cli, "run_presets", interrupted)
+    if code is None:
+        with pytest.raises(SystemError):
+            main(["presets"])
+        return
+    assert main(["presets"]) == code
+    assert capsys.readouterr().err == "shadelab: interrupted\n"

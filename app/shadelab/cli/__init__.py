@@ -62,6 +62,18 @@ def _terminated(signum, frame):
     raise _Terminated
 
 
+def _raised_by(exc: BaseException, kind: type) -> bool:
+    """True when ``exc`` was caused by an exception of ``kind``: a Ctrl+C that lands inside a
+    numba kernel (or its unpickling) surfaces as a chain of SystemErrors around it."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, kind):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return False
+
+
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     parser = build_parser()
@@ -91,6 +103,13 @@ def main(argv: list[str] | None = None) -> int:
     except _Terminated:
         print("shadelab: terminated", file=sys.stderr)
         return 143
+    except SystemError as exc:
+        for kind, word, code in ((KeyboardInterrupt, "interrupted", 130),
+                                 (_Terminated, "terminated", 143)):
+            if _raised_by(exc, kind):
+                print(f"shadelab: {word}", file=sys.stderr)
+                return code
+        raise
     except BrokenPipeError:  # 'shadelab presets | head -1': the reader has what it wanted
         try:
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no flush error
