@@ -37,6 +37,7 @@ class SceneGeometry:
     object_index : (F,) int64, index into ``scene.objects``
     casts_shadow : (F,) bool, the object's ``cast_shadows``
     diagonal : length of the scene's bounding-box diagonal, world units
+    corner_uvs : (F, 3, 2) float64 texture coordinates of the corners (the raster's uvs)
     """
 
     triangles: np.ndarray
@@ -45,6 +46,7 @@ class SceneGeometry:
     object_index: np.ndarray
     casts_shadow: np.ndarray
     diagonal: float
+    corner_uvs: np.ndarray | None = None
 
     @property
     def count(self) -> int:
@@ -57,16 +59,18 @@ def scene_geometry(scene: Scene, meshes: list[MeshData] | None = None) -> SceneG
     if not meshes or sum(len(m.faces) for m in meshes) == 0:
         empty3 = np.zeros((0, 3, 3))
         return SceneGeometry(empty3, np.zeros((0, 3)), empty3, np.zeros(0, np.int64),
-                             np.zeros(0, bool), 1.0)
+                             np.zeros(0, bool), 1.0, np.zeros((0, 3, 2)))
     triangles = np.concatenate([m.triangles for m in meshes])
     face_n = np.concatenate([m.face_normals for m in meshes])
     corner_n = np.concatenate([m.corner_normals for m in meshes])
+    corner_uv = np.concatenate([np.asarray(m.uvs, np.float64)[m.faces] for m in meshes])
     object_index = np.concatenate([np.full(len(m.faces), m.index, np.int64) for m in meshes])
     casts = np.array([scene.objects[i].cast_shadows for i in range(len(scene.objects))], bool)
     lo = triangles.reshape(-1, 3).min(axis=0)
     hi = triangles.reshape(-1, 3).max(axis=0)
     diagonal = float(np.linalg.norm(hi - lo)) or 1.0
-    return SceneGeometry(triangles, face_n, corner_n, object_index, casts[object_index], diagonal)
+    return SceneGeometry(triangles, face_n, corner_n, object_index, casts[object_index], diagonal,
+                         corner_uv)
 
 
 @dataclass

@@ -208,6 +208,10 @@ def _trace_batch_kernels(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarra
         else:
             kernels.local_shade_into(color, position, normal, d, mat, ctx.material_table,
                                      ctx.light_table, ctx.Ia, blinn, shadow, 1.0)
+        if ctx.detail.active:  # textured materials: Od(u, v) and bumped normals, reshaded
+            ctx.detail.reshade(color, position, normal, d, mat, tri[hit],
+                               np.asarray(u[hit], np.float64), np.asarray(v[hit], np.float64),
+                               shadow)
         kernels.add_weighted(out, px, w, color)
         if generation == depth:
             break

@@ -11,105 +11,22 @@ texture or a bump, so every other material keeps its exact output.
 
 from __future__ import annotations
 
-import os
-import warnings
-from pathlib import Path
-
 import moderngl
-import numpy as np
-from PIL import Image, UnidentifiedImageError
 
-from shadelab.errors import ShadeLabError
 from shadelab.gl.programs import set_uniform
-from shadelab.paths import file_problem
 from shadelab.scene.model import Material
-
-TEXTURE_MODES = {"": 0, "checker": 1}  # anything else: an image file (mode 2)
-BUMP_MODES = {"": 0, "bumps": 1}
-
-
-def has_surface_detail(material: Material) -> bool:
-    return bool(material.texture) or bool(material.bump)
-
-
-MAX_TEXTURE_PIXELS = 8192 * 8192  # 64 Mpixels: 768 MiB as float32 RGB, a GL texture's limit
-LIMIT_ENV = "SHADELAB_MAX_TEXTURE_PIXELS"
-
-
-def _resolve(path: str, base_dir: str, key: str) -> Path:
-    full = Path(path) if Path(path).is_absolute() else Path(base_dir) / path
-    problem = file_problem(full)
-    if problem:
-        raise ShadeLabError(f"{key}: image file '{full}' {problem}")
-    return full
-
-
-def texture_limit() -> int:
-    """The largest image (pixels) a texture may be; ``SHADELAB_MAX_TEXTURE_PIXELS`` raises it."""
-    text = os.environ.get(LIMIT_ENV, "")
-    if not text:
-        return MAX_TEXTURE_PIXELS
-    if not (text.isascii() and text.isdigit()) or int(text) < 1:
-        raise ShadeLabError(f"{LIMIT_ENV}={text!r}: expected a pixel count >= 1")
-    return int(text)
-
-
-def check_image_size(image: Image.Image, full: Path, key: str) -> None:
-    """Refuse an image too large to decode (a decompression bomb), from its header alone."""
-    w, h = image.size
-    limit = texture_limit()
-    if w * h > limit:
-        raise ShadeLabError(f"{key}: '{full.name}' is {w}x{h} = {w * h / 1e6:.0f} Mpixels, "
-                            f"over the texture limit of {limit / 1e6:.0f} Mpixels "
-                            f"(~{w * h * 12 / 2**30:.1f} GiB as float RGB); scale it down, "
-                            f"or set {LIMIT_ENV} to allow more")
-
-
-def srgb_to_linear(c: np.ndarray) -> np.ndarray:
-    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
-
-
-def _open_checked(full: Path, key: str) -> Image.Image:
-    """Image.open (the header only) with our size check in place of PIL's bomb check, whose
-    error names neither the limit nor how to raise it."""
-    saved = Image.MAX_IMAGE_PIXELS
-    Image.MAX_IMAGE_PIXELS = None
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", Image.DecompressionBombWarning)
-            image = Image.open(full)
-    finally:
-        Image.MAX_IMAGE_PIXELS = saved
-    try:
-        check_image_size(image, full, key)
-    except ShadeLabError:
-        image.close()
-        raise
-    return image
-
-
-def check_image_file(path: str, base_dir: str, key: str) -> tuple[int, int]:
-    """Read only the header: the file is an image within the size limit; its (w, h)."""
-    full = _resolve(path, base_dir, key)
-    try:
-        with _open_checked(full, key) as image:
-            return image.size
-    except (UnidentifiedImageError, OSError) as exc:
-        raise ShadeLabError(f"{key}: '{full.name}' could not be read as an image ({exc})") from None
-
-
-def load_image(path: str, base_dir: str, key: str, height: bool = False) -> np.ndarray:
-    """(H, W, 3) linear RGB or (H, W) height in [0, 1], float32, row 0 at the BOTTOM (GL's v)."""
-    full = _resolve(path, base_dir, key)
-    try:
-        with _open_checked(full, key) as image:
-            pixels = np.asarray(image.convert("L" if height else "RGB"), dtype=np.float32)
-    except (UnidentifiedImageError, OSError) as exc:
-        raise ShadeLabError(f"{key}: '{full.name}' could not be read as an image ({exc})") from None
-    pixels = pixels[::-1] / 255.0
-    if not height:
-        pixels = srgb_to_linear(pixels)
-    return np.ascontiguousarray(pixels, dtype=np.float32)
+from shadelab.shading.surface_detail import (  # noqa: F401  (re-exported, the pure half)
+    BUMP_MODES,
+    LIMIT_ENV,
+    MAX_TEXTURE_PIXELS,
+    TEXTURE_MODES,
+    check_image_file,
+    check_image_size,
+    has_surface_detail,
+    load_image,
+    srgb_to_linear,
+    texture_limit,
+)
 
 
 class TextureCache:
