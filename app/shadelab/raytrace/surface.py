@@ -7,6 +7,7 @@ Shared by the Whitted tracer, the ray tree and the path tracer so that all three
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -15,6 +16,8 @@ from shadelab.raytrace.accel import T_INF, Hits, SceneGeometry, build_accel, sce
 from shadelab.raytrace.detail import SceneDetail
 from shadelab.scene.model import Material, Scene
 from shadelab.shading.reference import light_vectors, shade
+
+MAX_SHADOW_CROSSINGS = 16  # transparent surfaces a shadow ray is followed through
 
 
 @dataclass
@@ -150,7 +153,11 @@ class TraceContext:
 
     # ------------------------------------------------------------ local model
     def shadow_factors(self, surf: Surface, select: np.ndarray | None = None) -> list[np.ndarray]:
-        """S_i per light for the points ``select`` (all by default): 1 lit, 0 in shadow."""
+        """S_i per light for the points ``select`` (all by default): 1 lit, 0 in shadow.
+
+        Each S_i is (N,) when no shadow caster is transparent (the opaque scenes' arrays,
+        bit for bit), else (N, 3): the kt-filtered transmittance of
+        :meth:`shadow_transmittance` where an occlusion query finds a blocker."""
         pos = surf.position if select is None else surf.position[select]
         ng = surf.geo_normal if select is None else surf.geo_normal[select]
         if self.kernels:
@@ -172,6 +179,7 @@ class TraceContext:
                 blocked = self.accel.occluded(origin, to_light[idx], tmax)
                 s[idx] = np.where(blocked, 0.0, 1.0)
                 self.shadow_rays += len(idx)
+                s = self._filter_blocked(s, idx, blocked, origin, to_light[idx], tmax)
             factors.append(s)
         return factors
 
@@ -189,8 +197,89 @@ class TraceContext:
                 blocked = self.accel.occluded(origin[idx], dirs[idx], tmax[idx])
                 s[idx] = np.where(blocked, 0.0, 1.0)
                 self.shadow_rays += len(idx)
+                s = self._filter_blocked(s, idx, blocked, origin[idx], dirs[idx], tmax[idx])
             factors.append(s)
         return factors
+
+    # ------------------------------------------------------------ kt-filtered shadows
+    @cached_property
+    def transparent_casters(self) -> bool:
+        """Does any shadow caster have kt > 0? Only then are shadow rays followed through
+        blockers (kt-filtered S_i); every other scene keeps its binary S_i, bit for bit."""
+        g = self.geometry
+        faces = g.object_index[g.casts_shadow]
+        return bool(len(faces)) and bool(np.any(self.kt[self.object_material[faces]] > 0.0))
+
+    def shadow_transmittance(self, origins: np.ndarray, dirs: np.ndarray,
+                             tmax: np.ndarray) -> np.ndarray:
+        """(M, 3) transmittance of M shadow rays: the product of kt Ot (kt alone for the
+        "interpolated" model, whose Ot is taken as 1) over every shadow-casting surface the
+        ray crosses before ``tmax``; 0 at the first opaque caster (kt = 0).
+
+        Each crossing is a surface: a closed transparent solid (a glass sphere) filters at
+        entry and at exit, a single quad pane once. Objects with ``cast_shadows = false``
+        are passed through with factor 1. The ray restarts eps past each hit; after
+        ``MAX_SHADOW_CROSSINGS`` crossings an occlusion query decides (blocked: 0).
+        """
+        g = self.geometry
+        m = len(origins)
+        trans = np.ones((m, 3))
+        filt = self.kt[:, None] * self.tint  # (materials, 3), 0 for the opaque ones
+        o = np.array(origins, dtype=np.float64).reshape(m, 3)
+        d = np.ascontiguousarray(dirs, dtype=np.float64).reshape(m, 3)
+        left = np.array(np.broadcast_to(tmax, (m,)), dtype=np.float64)
+        active = np.arange(m)
+        for _ in range(MAX_SHADOW_CROSSINGS):
+            if len(active) == 0:
+                return trans
+            hits = self.accel.intersect(o[active], d[active], left[active])
+            self.shadow_rays += len(active)
+            hit = (hits.tri >= 0) & (hits.t < left[active])
+            rows, t, tri = active[hit], hits.t[hit], hits.tri[hit]
+            material = self.object_material[g.object_index[tri]]
+            factor = np.where(g.casts_shadow[tri][:, None], filt[material], 1.0)
+            trans[rows] *= factor
+            step = t + self.eps
+            o[rows] += step[:, None] * d[rows]
+            left[rows] -= step
+            active = rows[(trans[rows].max(axis=1) > 0.0) & (left[rows] > 0.0)]
+        if len(active):
+            blocked = self.accel.occluded(o[active], d[active], left[active])
+            self.shadow_rays += len(active)
+            trans[active[blocked]] = 0.0
+        return trans
+
+    def _filter_blocked(self, s: np.ndarray, idx: np.ndarray, blocked: np.ndarray,
+                        origins: np.ndarray, dirs: np.ndarray, tmax: np.ndarray) -> np.ndarray:
+        """S_i (N,) unchanged without transparent casters, else (N, 3) with the blocked rays'
+        (``idx[blocked]``) transmittance in place of their 0."""
+        if not self.transparent_casters:
+            return s
+        s3 = np.repeat(s[:, None], 3, axis=1)
+        rows = np.flatnonzero(blocked)
+        if len(rows):
+            s3[idx[rows]] = self.shadow_transmittance(origins[rows], dirs[rows], tmax[rows])
+        return s3
+
+    def filtered_shadow_matrix(self, shadow: np.ndarray, light: np.ndarray, point: np.ndarray,
+                               blocked: np.ndarray, origins: np.ndarray, dirs: np.ndarray,
+                               tmax: np.ndarray) -> np.ndarray:
+        """The Whitted kernels' S (L, N) made (L, N, 3): each blocked shadow ray j (to light
+        ``light[j]`` from point ``point[j]``) gets its :meth:`shadow_transmittance`."""
+        s3 = np.repeat(shadow[:, :, None], 3, axis=2)
+        rows = np.flatnonzero(blocked)
+        if len(rows):
+            s3[light[rows], point[rows]] = self.shadow_transmittance(
+                origins[rows], dirs[rows], tmax[rows])
+        return s3
+
+    def local_per_channel(self, shade_one, shadow3: np.ndarray, out: np.ndarray) -> np.ndarray:
+        """The lecture's equation with a per-channel S_i: channel c of ``out`` is channel c
+        of ``shade_one(S[..., c])`` (every channel of I uses only its own S_i,c, so this is
+        I_c = Le_c + Ia_c ka Od_c + sum_i S_i,c f_att Ip_i,c [kd Od_c N.L + ks Os_c (R.V)^n])."""
+        for c in range(3):
+            out[:, c] = shade_one(np.ascontiguousarray(shadow3[..., c]))[:, c]
+        return out
 
     def local(self, surf: Surface, dirs: np.ndarray, shadow: list | None = None) -> np.ndarray:
         """The lecture's local model at each hit (reference.shade, with shadow-ray S_i)."""
@@ -198,6 +287,9 @@ class TraceContext:
         if len(out) == 0:
             return out
         shadow = self.shadow_factors(surf) if shadow is None else shadow
+        if shadow and np.ndim(shadow[0]) == 2:  # kt-filtered S_i (N, 3): a pass per channel
+            return self.local_per_channel(lambda s: self.local(surf, dirs, list(s)),
+                                          np.stack(shadow), out)
         mat = self.material_ids(surf)
         if self.kernels:
             s = (np.stack(shadow) if shadow else np.zeros((0, len(out))))
