@@ -204,3 +204,41 @@ def test_a_stand_in_light_is_left_to_the_surface_it_stands_for():
     with pytest.raises(ShadeLabError, match="stand_in"):
         check_lit(dark, "cornell")
     check_lit(load_preset("whitted"), "whitted")  # lit by its lights alone: accepted
+
+
+@pytest.mark.parametrize("local", ["numba", "numpy"])
+def test_textures_and_bumps_in_the_path_tracer_first_bounce(local):
+    """surface-detail (checker floor, brick wall with a height map, a bumpy sphere) lit by its
+    lecture lights, Ia = 0: each camera path's direct term equals Whitted's local model at
+    depth 0, which matches the raster's texture lookups (tests/test_raytrace_detail.py); the
+    same scene without its textures differs."""
+    from shadelab.raytrace.accel import Hits
+    from shadelab.raytrace.pathtrace import PathTracer
+    from shadelab.raytrace.surface import TraceContext
+
+    scene = load_preset("surface-detail")
+    scene.Ia = (0.0, 0.0, 0.0)
+    o, d = primary_rays(scene.camera, 40, 30)
+    o, d = o.reshape(-1, 3), d.reshape(-1, 3)
+    tracer = PathTracer(scene, local=local)
+    # only the first bounce: no other bounce may add light, so compare the delta-light term
+    ctx = tracer.ctx
+    hits = ctx.accel.intersect(o, d)
+    keep = np.flatnonzero(hits.hit)
+    surf = ctx.surface(o[keep], d[keep], Hits(hits.t[keep], hits.tri[keep], hits.u[keep],
+                                               hits.v[keep]))
+    mat = ctx.object_material[surf.obj]
+    got = tracer._delta_lights(surf, d[keep], mat, tracer._detail(surf, mat))
+    whitted = TraceContext(scene, local=local)
+    wsurf = whitted.surface(o[keep], d[keep], Hits(hits.t[keep], hits.tri[keep],
+                                                     hits.u[keep], hits.v[keep]))
+    expected = whitted.local(wsurf, d[keep])
+    emission = np.array([m.emission for m in whitted.materials])[mat]
+    np.testing.assert_allclose(got, expected - emission, rtol=1e-6, atol=1e-9)
+    untextured = ["materials.checker.texture=", "materials.bricks.texture=",
+                  "materials.bricks.bump=", "materials.bumpy.bump="]
+    plain = PathTracer(load_preset("surface-detail", untextured), local=local)
+    psurf = plain.ctx.surface(o[keep], d[keep], Hits(hits.t[keep], hits.tri[keep],
+                                                       hits.u[keep], hits.v[keep]))
+    flat = plain._delta_lights(psurf, d[keep], mat, plain._detail(psurf, mat))
+    assert np.abs(flat - got).max() > 0.05

@@ -165,9 +165,13 @@ class PathTracer:
             t = hits.t[keep]
             surf = ctx.surface(o, d, Hits(t, hits.tri[keep], hits.u[keep], hits.v[keep]))
             mat = ctx.object_material[surf.obj]
+            textured = self._detail(surf, mat)
             _add(out, pixel, beta * self._emitted(surf, d, t, mat, bsdf_pdf))
-            _add(out, pixel, beta * self._delta_lights(surf, d, mat))
+            _add(out, pixel, beta * self._delta_lights(surf, d, mat, textured))
             rho = self.rho[mat]
+            if textured is not None:
+                idx, od = textured
+                rho[idx] = np.array([m.kd for m in ctx.materials])[mat[idx], None] * od
             p_diffuse = rho.mean(axis=1) / np.maximum(
                 rho.mean(axis=1) + self.kr[mat] + self.kt[mat], 1e-300)
             _add(out, pixel, beta * self._next_event(surf, rho, p_diffuse, rng))
@@ -205,14 +209,15 @@ class PathTracer:
             t = hits.t[keep]
             surf = ctx.surface(o, d, Hits(t, hits.tri[keep], hits.u[keep], hits.v[keep]))
             mat = ctx.object_material[surf.obj]
+            textured = self._detail(surf, mat)
             if self.delta_lights:
-                kernels.add_rows(out, pixel, beta * self._delta_lights(surf, d, mat),
+                kernels.add_rows(out, pixel, beta * self._delta_lights(surf, d, mat, textured),
                                  np.ones(len(pixel), np.bool_))
+            mat, tables = self._textured_tables(mat, textured)
             (nee_o, nee_d, nee_t, nee_ok, nee_val, o, d, beta, bsdf_pdf,
              alive) = kernels.path_vertex(
                 out, pixel, beta, bsdf_pdf, surf.position, surf.normal, surf.geo_normal,
-                surf.entering, np.ascontiguousarray(d), t, mat,
-                (self.rho, self.kr, self.kt, self.ior, self.emission),
+                surf.entering, np.ascontiguousarray(d), t, mat, tables,
                 (em.cdf, em.p0, em.e1, em.e2, em.normal, em.le, float(em.total_area)),
                 ctx.eps, rng.random((len(t), 7)), bounce >= RR_START)
             cand = np.flatnonzero(nee_ok)
@@ -225,7 +230,43 @@ class PathTracer:
                                            bsdf_pdf[alive])
         return out
 
-    def _delta_lights(self, surf, d: np.ndarray, mat: np.ndarray) -> np.ndarray:
+    def _detail(self, surf, mat: np.ndarray):
+        """Textured hits: their bumped normals written into ``surf`` and their Od(u, v) as
+        (index, Od) — None when no hit is on a textured material. The same lookups as
+        Whitted and the raster (:mod:`shadelab.shading.surface_detail`)."""
+        detail = self.ctx.detail
+        if not detail.active or surf.hits is None:
+            return None
+        h = surf.hits
+        parts = []
+        for m in detail.details:
+            idx = np.flatnonzero(mat == m)
+            if len(idx):
+                od, n = detail.od_and_normal(m, h.tri[idx], h.u[idx], h.v[idx],
+                                             surf.normal[idx])
+                surf.normal[idx] = n
+                parts.append((idx, od))
+        if not parts:
+            return None
+        return (np.concatenate([i for i, _ in parts]), np.concatenate([o for _, o in parts]))
+
+    def _textured_tables(self, mat: np.ndarray, textured):
+        """Material tables with one extra row per textured hit (its kd Od(u, v)), and the hits'
+        material indices pointing at those rows: the kernels stay per-material."""
+        tables = (self.rho, self.kr, self.kt, self.ior, self.emission)
+        if textured is None:
+            return mat, tables
+        idx, od = textured
+        base = mat[idx]
+        kd = np.array([m.kd for m in self.ctx.materials])[base]
+        rows = len(self.rho)
+        mat = mat.copy()
+        mat[idx] = rows + np.arange(len(idx))
+        rho = np.concatenate([self.rho, kd[:, None] * od])
+        return mat, (rho, *(np.concatenate([t, t[base]]) for t in tables[1:]))
+
+    def _delta_lights(self, surf, d: np.ndarray, mat: np.ndarray,
+                      textured=None) -> np.ndarray:
         """The lecture's direct term of every (non stand-in) light at the hits, shadow rays
         giving S_i (objects with ``cast_shadows = false`` do not block, as in Whitted)."""
         n = len(d)
@@ -243,10 +284,21 @@ class PathTracer:
                 blocked = ctx.accel.occluded(origin[idx], dirs[idx], tmax[idx])
                 shadow[k, idx] = np.where(blocked, 0.0, 1.0)
                 self.rays += len(idx)
-        return kernels.local_shade(pos, np.ascontiguousarray(surf.normal),
-                                   np.ascontiguousarray(-d), mat, self.direct_materials,
-                                   self.delta_table, np.zeros(3), ctx.specular == "blinn",
-                                   shadow)
+        out = kernels.local_shade(pos, np.ascontiguousarray(surf.normal),
+                                  np.ascontiguousarray(-d), mat, self.direct_materials,
+                                  self.delta_table, np.zeros(3), ctx.specular == "blinn",
+                                  shadow)
+        if textured is not None:  # the same terms with Od(u, v) (no ambient, no emission)
+            idx, od = textured
+            table = self.direct_materials[mat[idx]]  # a copy (fancy index)
+            table[:, kernels.M_OD:kernels.M_OD + 3] = od
+            out[idx] = kernels.local_shade(pos[idx], np.ascontiguousarray(surf.normal[idx]),
+                                           np.ascontiguousarray(-d[idx]),
+                                           np.arange(len(idx)), np.ascontiguousarray(table),
+                                           self.delta_table, np.zeros(3),
+                                           ctx.specular == "blinn",
+                                           np.ascontiguousarray(shadow[:, idx]))
+        return out
 
     def _emitted(self, surf, d: np.ndarray, t: np.ndarray, mat: np.ndarray,
                  bsdf_pdf: np.ndarray) -> np.ndarray:
