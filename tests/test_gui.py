@@ -11,8 +11,6 @@ from __future__ import annotations
 
 import json
 import os
-import select
-import shutil
 import subprocess
 import sys
 import time
@@ -20,6 +18,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
+from gui_harness import capture, private_xvfb, run_scenario_main
 
 ROOT = Path(__file__).resolve().parent.parent
 WINDOW = (1280, 720)
@@ -34,24 +34,7 @@ pytestmark = pytest.mark.gui
 @pytest.fixture(scope="module")
 def xdisplay():
     """A private Xvfb server for this module; yields its DISPLAY string."""
-    if shutil.which("Xvfb") is None:
-        pytest.skip("Xvfb is not installed (apt-get install xvfb): GUI tests need a display")
-    read_fd, write_fd = os.pipe()
-    proc = subprocess.Popen(["Xvfb", "-displayfd", str(write_fd), "-screen", "0",
-                             f"{WINDOW[0] + 64}x{WINDOW[1] + 64}x24", "-nolisten", "tcp"],
-                            pass_fds=(write_fd,), stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
-    os.close(write_fd)
-    ready, _, _ = select.select([read_fd], [], [], 20.0)
-    number = os.read(read_fd, 64).decode().strip() if ready else ""
-    try:
-        if not number or proc.poll() is not None:
-            pytest.skip("Xvfb did not start")
-        yield f":{number}"
-    finally:
-        proc.terminate()
-        proc.wait(10)
-        os.close(read_fd)  # only now: Xvfb dies of SIGPIPE if it writes to a closed pipe
+    yield from private_xvfb(f"{WINDOW[0] + 64}x{WINDOW[1] + 64}x24")
 
 
 def run_scenario(name: str, display: str, tmp_path: Path, script: str = __file__,
@@ -249,7 +232,7 @@ def scenario_probe_click(ctx, state, out: dict) -> None:
     from shadelab.ui import overlays
 
     out["arrows"] = len(overlays.probe_arrows(p, 1.0)) // 10  # 5 segments (10 ends) each
-    _capture(ctx, str(Path(OUT_DIR) / "probe.png"))
+    capture(ctx, str(Path(OUT_DIR) / "probe.png"))
     eye = state.scene.camera.eye
     ctx.item_drag_with_delta("viewport_input", imgui_vec(60, 20))
     ctx.yield_(2)
@@ -390,31 +373,10 @@ def imgui_vec(x: float, y: float):
     return imgui.ImVec2(x, y)
 
 
-def _capture(ctx, path: str) -> None:
-    from imgui_bundle import imgui
-    from imgui_bundle.immapp import testing
-
-    testing.capture(ctx, path, flags=imgui.test_engine.CaptureFlags_.hide_mouse_cursor)
-
-
 def _main(name: str, out_dir: str) -> int:
     global OUT_DIR
     OUT_DIR = out_dir
-    from shadelab.scene import load_preset
-    from shadelab.ui.app import ViewerOptions, run_viewer
-    from shadelab.ui.state import AppState
-
-    scenario = globals()[f"scenario_{name}"]
-    out: dict = {}
-    state = AppState.from_scene(load_preset("cornell"), "cornell")
-    state.screenshot_dir = out_dir
-
-    def body(ctx, state):
-        scenario(ctx, state, out)
-
-    run_viewer(state, ViewerOptions(window_size=WINDOW, test_function=body))
-    Path(out_dir, f"{name}.json").write_text(json.dumps(out))
-    return 0
+    return run_scenario_main(globals(), name, out_dir, "cornell", WINDOW)
 
 
 if __name__ == "__main__":

@@ -9,7 +9,6 @@ Run one by hand:  xvfb-run -a python3 tests/test_gui_pipelines.py follow_edits /
 
 from __future__ import annotations
 
-import json
 import subprocess
 import sys
 from pathlib import Path
@@ -18,6 +17,7 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from gui_harness import run_scenario_main  # noqa: E402
 from test_gui import _probe_at, _wait, run_scenario  # noqa: E402
 from test_gui import xdisplay as _xdisplay_fixture  # noqa: E402
 
@@ -321,21 +321,7 @@ def _key(name: str):
 def _main(name: str, out_dir: str) -> int:
     global OUT_DIR
     OUT_DIR = out_dir
-    from shadelab.scene import load_preset
-    from shadelab.ui.app import ViewerOptions, run_viewer
-    from shadelab.ui.state import AppState
-
-    scenario = globals()[f"scenario_{name}"]
-    out: dict = {}
-    state = AppState.from_scene(load_preset("cornell"), "cornell")
-    state.screenshot_dir = out_dir
-
-    def body(ctx, state):
-        scenario(ctx, state, out)
-
-    run_viewer(state, ViewerOptions(window_size=WINDOW, test_function=body))
-    Path(out_dir, f"{name}.json").write_text(json.dumps(out))
-    return 0
+    return run_scenario_main(globals(), name, out_dir, "cornell", WINDOW)
 
 
 if __name__ == "__main__":

@@ -10,11 +10,6 @@ Run one by hand:  xvfb-run -s "-screen 0 1920x1080x24" python3 tests/test_gui_pr
 
 from __future__ import annotations
 
-import json
-import os
-import select
-import shutil
-import subprocess
 import sys
 from pathlib import Path
 
@@ -22,6 +17,7 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from gui_harness import capture, private_xvfb, run_scenario_main  # noqa: E402
 from test_gui import run_scenario  # noqa: E402
 
 pytestmark = pytest.mark.gui
@@ -32,24 +28,7 @@ DOCK_WINDOWS = ("Scene", "Lights", "Materials", "Objects", "Equation & probe", "
 @pytest.fixture(scope="module")
 def bigdisplay():
     """A private Xvfb screen that holds a 1920x1080 window."""
-    if shutil.which("Xvfb") is None:
-        pytest.skip("Xvfb is not installed (apt-get install xvfb): GUI tests need a display")
-    read_fd, write_fd = os.pipe()
-    proc = subprocess.Popen(["Xvfb", "-displayfd", str(write_fd), "-screen", "0",
-                             "1984x1144x24", "-nolisten", "tcp"],
-                            pass_fds=(write_fd,), stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
-    os.close(write_fd)
-    ready, _, _ = select.select([read_fd], [], [], 20.0)
-    number = os.read(read_fd, 64).decode().strip() if ready else ""
-    try:
-        if not number or proc.poll() is not None:
-            pytest.skip("Xvfb did not start")
-        yield f":{number}"
-    finally:
-        proc.terminate()
-        proc.wait(10)
-        os.close(read_fd)
+    yield from private_xvfb("1984x1144x24")
 
 
 def _run(name, display, tmp_path):
@@ -163,7 +142,7 @@ def _check_layout(ctx, state, out: dict) -> None:
                                 round(rect.min.x), round(rect.max.x), round(inner.max.x)])
         checked[label] = count
     out["clipped"], out["checked"] = clipped, checked
-    _capture(ctx, str(Path(OUT_DIR) / "presenter.png"))
+    capture(ctx, str(Path(OUT_DIR) / "presenter.png"))
     ctx.key_press(imgui.Key.tab)
     ctx.yield_(5)
     from imgui_bundle import hello_imgui
@@ -174,7 +153,7 @@ def _check_layout(ctx, state, out: dict) -> None:
     out["hidden_visible"] = [w.label for w in windows if w.is_visible]
     out["presenter_viewport"] = list(state.viewport_size)
     out["caption"] = caption_text(state)
-    _capture(ctx, str(Path(OUT_DIR) / "presenter-tab.png"))
+    capture(ctx, str(Path(OUT_DIR) / "presenter-tab.png"))
     ctx.key_press(imgui.Key.tab)
     ctx.yield_(5)
     out["shown_again"] = sorted(w.label for w in windows if w.is_visible)
@@ -208,7 +187,7 @@ def scenario_lesson_walk(ctx, state, out: dict) -> None:
         if i == 0:
             out["step1_light_enabled"] = state.scene.lights[0].enabled
             out["step1_shadows"] = state.scene.render.shadows
-            _capture(ctx, str(Path(OUT_DIR) / "lesson.png"))
+            capture(ctx, str(Path(OUT_DIR) / "lesson.png"))
     ctx.key_press(imgui.Key.page_down)  # past the end: stays on the last step
     ctx.yield_(2)
     ctx.key_press(imgui.Key.page_up)
@@ -392,32 +371,11 @@ def scenario_dialogs(ctx, state, out: dict) -> None:
     out["frames_after_error"] = state.frame - frame
 
 
-def _capture(ctx, path: str) -> None:
-    from imgui_bundle import imgui
-    from imgui_bundle.immapp import testing
-
-    testing.capture(ctx, path, flags=imgui.test_engine.CaptureFlags_.hide_mouse_cursor)
-
-
 def _main(name: str, out_dir: str) -> int:
     global OUT_DIR
     OUT_DIR = out_dir
-    from shadelab.scene import load_preset
-    from shadelab.ui.app import ViewerOptions, run_viewer
-    from shadelab.ui.state import AppState
-
-    scenario = globals()[f"scenario_{name}"]
-    out: dict = {}
-    state = AppState.from_scene(load_preset("lecture"), "lecture")
-    state.screenshot_dir = out_dir
-
-    def body(ctx, state):
-        scenario(ctx, state, out)
-
-    run_viewer(state, ViewerOptions(window_size=SIZES.get(name, (1280, 720)),
-                                    test_function=body, autosave=False))
-    Path(out_dir, f"{name}.json").write_text(json.dumps(out))
-    return 0
+    return run_scenario_main(globals(), name, out_dir, "lecture", SIZES.get(name, (1280, 720)),
+                             autosave=False)
 
 
 if __name__ == "__main__":

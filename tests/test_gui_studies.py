@@ -9,12 +9,12 @@ Run one scenario by hand:  xvfb-run -a python3 tests/test_gui_studies.py gallery
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
 import pytest
 
+from gui_harness import run_scenario_main
 from test_gui import _wait, run_scenario, xdisplay  # noqa: F401  (private Xvfb, helpers)
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -263,18 +263,7 @@ def scenario_studies(ctx, state, out: dict) -> None:
 
 
 def _main(name: str, out_dir: str) -> int:
-    from shadelab.scene import load_preset
-    from shadelab.ui.app import ViewerOptions, run_viewer
-    from shadelab.ui.state import AppState
-
-    scenario = globals()[f"scenario_{name}"]
-    out: dict = {}
-    state = AppState.from_scene(load_preset("cornell"), "cornell")
-    state.screenshot_dir = out_dir
-    run_viewer(state, ViewerOptions(window_size=(1280, 720),
-                                    test_function=lambda ctx, st: scenario(ctx, st, out)))
-    Path(out_dir, f"{name}.json").write_text(json.dumps(out))
-    return 0
+    return run_scenario_main(globals(), name, out_dir, "cornell", (1280, 720))
 
 
 if __name__ == "__main__":

@@ -8,11 +8,6 @@ Each scenario runs in its own process under a private Xvfb. Run one by hand:
 
 from __future__ import annotations
 
-import json
-import os
-import select
-import shutil
-import subprocess
 import sys
 from pathlib import Path
 
@@ -20,6 +15,7 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from gui_harness import private_xvfb, run_scenario_main  # noqa: E402
 from test_gui import run_scenario, xdisplay  # noqa: E402,F401  (the module's Xvfb fixture)
 
 pytestmark = pytest.mark.gui
@@ -55,24 +51,7 @@ def test_translate_and_scale_in_the_objects_panel_move_the_pixels(xdisplay, tmp_
 @pytest.fixture(scope="module")
 def display_4k():
     """A private 4K Xvfb screen (skipped when Xvfb cannot make one)."""
-    if shutil.which("Xvfb") is None:
-        pytest.skip("Xvfb is not installed (apt-get install xvfb): GUI tests need a display")
-    read_fd, write_fd = os.pipe()
-    proc = subprocess.Popen(["Xvfb", "-displayfd", str(write_fd), "-screen", "0",
-                             "3904x2224x24", "-nolisten", "tcp"],
-                            pass_fds=(write_fd,), stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
-    os.close(write_fd)
-    ready, _, _ = select.select([read_fd], [], [], 20.0)
-    number = os.read(read_fd, 64).decode().strip() if ready else ""
-    try:
-        if not number or proc.poll() is not None:
-            pytest.skip("Xvfb could not make a 3904x2224 screen")
-        yield f":{number}"
-    finally:
-        proc.terminate()
-        proc.wait(10)
-        os.close(read_fd)
+    yield from private_xvfb("3904x2224x24", failed="Xvfb could not make a 3904x2224 screen")
 
 
 def test_presenter_layout_at_3840x2160_cuts_nothing_off(display_4k, tmp_path):
@@ -183,22 +162,7 @@ def _main(name: str, out_dir: str) -> int:
     import test_gui_presenter
 
     test_gui_presenter.OUT_DIR = out_dir
-    from shadelab.scene import load_preset
-    from shadelab.ui.app import ViewerOptions, run_viewer
-    from shadelab.ui.state import AppState
-
-    scenario = globals()[f"scenario_{name}"]
-    out: dict = {}
-    state = AppState.from_scene(load_preset("lecture"), "lecture")
-    state.screenshot_dir = out_dir
-
-    def body(ctx, state):
-        scenario(ctx, state, out)
-
-    run_viewer(state, ViewerOptions(window_size=SIZES[name], test_function=body,
-                                    autosave=False))
-    Path(out_dir, f"{name}.json").write_text(json.dumps(out))
-    return 0
+    return run_scenario_main(globals(), name, out_dir, "lecture", SIZES[name], autosave=False)
 
 
 if __name__ == "__main__":

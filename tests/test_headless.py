@@ -6,8 +6,6 @@ from __future__ import annotations
 
 import os
 import re
-import select
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -15,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from gui_harness import private_xvfb
 from shadelab.resources import shaders_dir
 from shadelab.testing import assert_images_close
 
@@ -38,24 +37,7 @@ def _shadelab(args: list[str], env: dict, cwd: Path) -> subprocess.CompletedProc
 @pytest.fixture(scope="module")
 def xvfb():
     """A private Xvfb server (as tests/test_gui.py starts one); yields its DISPLAY."""
-    if shutil.which("Xvfb") is None:
-        pytest.skip("Xvfb is not installed (apt-get install xvfb): the GLX path needs a display")
-    read_fd, write_fd = os.pipe()
-    proc = subprocess.Popen(["Xvfb", "-displayfd", str(write_fd), "-screen", "0", "320x240x24",
-                             "-nolisten", "tcp"], pass_fds=(write_fd,),
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    os.close(write_fd)
-    ready, _, _ = select.select([read_fd], [], [], 20.0)
-    number = os.read(read_fd, 64).decode().strip() if ready else ""
-    try:
-        if not number or proc.poll() is not None:
-            pytest.skip("Xvfb did not start")
-        yield f":{number}"
-    finally:
-        proc.terminate()
-        proc.wait(10)
-        os.close(read_fd)
-
+    yield from private_xvfb("320x240x24", why="the GLX path needs a display")
 
 @pytest.mark.gl
 @pytest.mark.slow
