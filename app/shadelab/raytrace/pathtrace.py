@@ -123,6 +123,7 @@ class PathTracer:
                  local: str = "numba"):
         self.ctx = TraceContext(scene, backend, local=local) if ctx is None else ctx
         mats = self.ctx.materials
+        self.kd = np.array([m.kd for m in mats], float)
         self.rho = np.array([np.multiply(m.kd, m.Od) for m in mats], float).reshape(-1, 3)
         self.kr = np.array([m.mirror for m in mats], float)
         self.kt = np.array([m.kt for m in mats], float)
@@ -143,7 +144,7 @@ class PathTracer:
         """One-sample estimates of L (N, 3) along N camera rays."""
         if self.ctx.kernels:
             return self._radiance_kernel(origins, dirs, rng)
-        ctx, n = self.ctx, len(origins)
+        n = len(origins)
         out = np.zeros((n, 3))
         beta = np.ones((n, 3))
         pixel = np.arange(n)
@@ -154,24 +155,14 @@ class PathTracer:
         for bounce in range(MAX_BOUNCES):
             if len(o) == 0:
                 break
-            hits = ctx.accel.intersect(o, d)
-            self.rays += len(o)
-            if bounce == 0:
-                self.primary_hits += int(hits.hit.sum())
-            miss = ~hits.hit
-            _add(out, pixel[miss], beta[miss] * ctx.background)
-            keep = np.flatnonzero(hits.hit)
-            o, d, beta, pixel, bsdf_pdf = o[keep], d[keep], beta[keep], pixel[keep], bsdf_pdf[keep]
-            t = hits.t[keep]
-            surf = ctx.surface(o, d, Hits(t, hits.tri[keep], hits.u[keep], hits.v[keep]))
-            mat = ctx.object_material[surf.obj]
-            textured = self._detail(surf, mat)
+            o, d, beta, pixel, bsdf_pdf, t, surf, mat, textured = self._hit_vertex(
+                out, o, d, beta, pixel, bsdf_pdf, bounce)
             _add(out, pixel, beta * self._emitted(surf, d, t, mat, bsdf_pdf))
             _add(out, pixel, beta * self._delta_lights(surf, d, mat, textured))
             rho = self.rho[mat]
             if textured is not None:
                 idx, od = textured
-                rho[idx] = np.array([m.kd for m in ctx.materials])[mat[idx], None] * od
+                rho[idx] = self.kd[mat[idx], None] * od
             p_diffuse = rho.mean(axis=1) / np.maximum(
                 rho.mean(axis=1) + self.kr[mat] + self.kt[mat], 1e-300)
             _add(out, pixel, beta * self._next_event(surf, rho, p_diffuse, rng))
@@ -198,18 +189,8 @@ class PathTracer:
         for bounce in range(MAX_BOUNCES):
             if len(o) == 0:
                 break
-            hits = ctx.accel.intersect(o, d)
-            self.rays += len(o)
-            if bounce == 0:
-                self.primary_hits += int(hits.hit.sum())
-            miss = ~hits.hit
-            kernels.add_rows(out, pixel, beta * ctx.background, miss)
-            keep = np.flatnonzero(hits.hit)
-            o, d, beta, pixel, bsdf_pdf = o[keep], d[keep], beta[keep], pixel[keep], bsdf_pdf[keep]
-            t = hits.t[keep]
-            surf = ctx.surface(o, d, Hits(t, hits.tri[keep], hits.u[keep], hits.v[keep]))
-            mat = ctx.object_material[surf.obj]
-            textured = self._detail(surf, mat)
+            o, d, beta, pixel, bsdf_pdf, t, surf, mat, textured = self._hit_vertex(
+                out, o, d, beta, pixel, bsdf_pdf, bounce)
             if self.delta_lights:
                 kernels.add_rows(out, pixel, beta * self._delta_lights(surf, d, mat, textured),
                                  np.ones(len(pixel), np.bool_))
@@ -229,6 +210,26 @@ class PathTracer:
             o, d, beta, pixel, bsdf_pdf = (o[alive], d[alive], beta[alive], pixel[alive],
                                            bsdf_pdf[alive])
         return out
+
+    def _hit_vertex(self, out, o, d, beta, pixel, bsdf_pdf, bounce: int):
+        """One bounce's closest hits: paths that miss add the background and end; the rest
+        come back with their surface, material indices and textured hits (both estimators)."""
+        ctx = self.ctx
+        hits = ctx.accel.intersect(o, d)
+        self.rays += len(o)
+        if bounce == 0:
+            self.primary_hits += int(hits.hit.sum())
+        if ctx.kernels:
+            kernels.add_rows(out, pixel, beta * ctx.background, ~hits.hit)
+        else:
+            miss = ~hits.hit
+            _add(out, pixel[miss], beta[miss] * ctx.background)
+        keep = np.flatnonzero(hits.hit)
+        o, d, beta, pixel, bsdf_pdf = o[keep], d[keep], beta[keep], pixel[keep], bsdf_pdf[keep]
+        t = hits.t[keep]
+        surf = ctx.surface(o, d, Hits(t, hits.tri[keep], hits.u[keep], hits.v[keep]))
+        mat = ctx.object_material[surf.obj]
+        return o, d, beta, pixel, bsdf_pdf, t, surf, mat, self._detail(surf, mat)
 
     def _detail(self, surf, mat: np.ndarray):
         """Textured hits: their bumped normals written into ``surf`` and their Od(u, v) as
@@ -258,11 +259,10 @@ class PathTracer:
             return mat, tables
         idx, od = textured
         base = mat[idx]
-        kd = np.array([m.kd for m in self.ctx.materials])[base]
         rows = len(self.rho)
         mat = mat.copy()
         mat[idx] = rows + np.arange(len(idx))
-        rho = np.concatenate([self.rho, kd[:, None] * od])
+        rho = np.concatenate([self.rho, self.kd[base, None] * od])
         return mat, (rho, *(np.concatenate([t, t[base]]) for t in tables[1:]))
 
     def _delta_lights(self, surf, d: np.ndarray, mat: np.ndarray,
