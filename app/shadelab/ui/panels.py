@@ -385,12 +385,13 @@ def _rgb(v, digits: int = 3) -> str:
 def _term_row(label: str, value) -> None:
     imgui.table_next_row()
     imgui.table_next_column()
-    imgui.text(label)
+    imgui.text_wrapped(label)
     values = np.asarray(value, dtype=np.float64).reshape(-1)
     for c in range(3):
         imgui.table_next_column()
         if c < len(values):
-            imgui.text(f"{values[c]:.4g}")
+            v = values[c]  # tiny values short (e.g. 4.0e-66) so narrow columns show them
+            imgui.text(f"{v:.4g}" if v == 0 or abs(v) >= 1e-3 else f"{v:.1e}")
 
 
 def draw_equation_panel(state: AppState) -> bool:
@@ -422,11 +423,13 @@ def draw_equation_panel(state: AppState) -> bool:
                        + ("H_i" if blinn else "R_i") + " magenta")
     imgui.pop_text_wrap_pos()
     lights = scene.active_lights()
+    # Stretched to the panel's width (the term column wider): every column stays on screen
+    # in a narrow presenter layout (1024x768), where fixed-fit columns pushed B off the edge.
     flags = (imgui.TableFlags_.borders | imgui.TableFlags_.row_bg
-             | imgui.TableFlags_.sizing_fixed_fit)
+             | imgui.TableFlags_.sizing_stretch_prop)
     if imgui.begin_table("terms", 4, flags):
-        for head in ("term", "R", "G", "B"):
-            imgui.table_setup_column(head)
+        for head, weight in (("term", 1.8), ("R", 1.0), ("G", 1.0), ("B", 1.0)):
+            imgui.table_setup_column(head, imgui.TableColumnFlags_.width_stretch, weight)
         imgui.table_headers_row()
         terms = result.terms
         _term_row("Le (emission)", terms.emission)
