@@ -403,3 +403,28 @@ def test_open_a_mesh_file_adds_it_and_a_broken_one_keeps_the_scene(tmp_path):
     assert "broken.obj" in state.error and len(state.scene.objects) == count + 1
     assert not state.open_file(str(tmp_path / "missing.ply"))
     assert "not found" in state.error
+
+
+def test_save_never_overwrites_a_shipped_preset(tmp_path, monkeypatch):
+    """Save (and Ctrl+S) on a preset ShadeLab ships asks where (Save as) and leaves the file;
+    on the user's own file it writes in place."""
+    from shadelab.resources import presets_dir
+    from shadelab.ui import dialogs, panels
+
+    asked = []
+    monkeypatch.setattr(dialogs, "ask", lambda state, purpose: asked.append(purpose))
+    shipped = presets_dir() / "cornell.toml"
+    before = shipped.read_bytes()
+    state = AppState.from_scene(load_preset("cornell"), "cornell")
+    state.preset_path = str(shipped)
+    state.scene.materials["white"].kd = 0.5
+    try:
+        panels.save_here(state)
+        assert asked == ["save"] and shipped.read_bytes() == before
+    finally:  # a regression must not leave the shipped preset changed
+        if shipped.read_bytes() != before:
+            shipped.write_bytes(before)
+    own = tmp_path / "mine.toml"
+    state.preset_path = str(own)
+    panels.save_here(state)
+    assert asked == ["save"] and load_preset(str(own)).materials["white"].kd == 0.5
