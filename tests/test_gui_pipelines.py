@@ -54,7 +54,13 @@ def test_raytrace_pipeline_draws_the_cli_image_in_the_viewport(xdisplay, tmp_pat
     w, h = r["size"]
     viewport = np.load(tmp_path / "viewport.npy")
     assert viewport.shape == (h, w, 3)
-    assert r["levels_seen"][0] == 8 and r["levels_seen"][-1] == 1   # coarse first
+    # coarse first: the job published 1/8, 1/4, 1/2 and full resolution in that order ...
+    assert r["levels_published"] == [8, 4, 2, 1]
+    # ... and the viewport showed a subsequence of them (a loaded machine may skip a level
+    # between two frames; the newest is always the one shown), ending at full resolution
+    seen = r["levels_seen"]
+    assert seen and seen[-1] == 1 and seen == sorted(seen, reverse=True)
+    assert set(seen) <= {8, 4, 2, 1}
     out = tmp_path / "cli.npy"
     proc = subprocess.run([sys.executable, "-m", "shadelab", "raytrace", "cornell", "-o",
                            str(tmp_path / "cli.png"), "--size", f"{w}x{h}", "--npy", str(out)],
@@ -188,6 +194,9 @@ def scenario_raytrace_pipeline(ctx, state, out: dict) -> None:
                              view.stats.get("done") and not view.runner.running)[1], 6000)
     assert ok, f"raytrace pipeline did not finish: {view.message} {view.runner.error}"
     out["levels_seen"] = [lv for lv in levels if lv is not None]
+    published = [t["level"] for t in view.runner.trail if t["level"] is not None]
+    out["levels_published"] = [lv for i, lv in enumerate(published)
+                               if i == 0 or lv != published[i - 1]]
     out["frames_while_refining"] = state.frame - frame0
     out["size"] = list(view.job_size)
     np.save(Path(OUT_DIR) / "viewport.npy", view.linear)

@@ -32,6 +32,7 @@ from shadelab.scene.preset import clone_scene
 
 JobFactory = Callable[[Scene, tuple[int, int]], Iterator[Progress]]
 KILL_AFTER = 3.0   # seconds a cancelled process job may take before its process is ended
+TRAIL_MAX = 4096   # Progress entries a job keeps in its trail (a test and the log read it)
 
 
 def _picklable(step: Progress) -> Progress:
@@ -160,6 +161,7 @@ class JobRunner:
         self.cancelled = False
         self.cancel_requested = 0.0     # perf_counter() of the last cancel
         self.version = 0                # bumps on every new Progress (the UI re-uploads then)
+        self.trail: list[dict] = []     # every Progress of the job, in brief (the UI may skip some)
         self._cancel = threading.Event()
         self._thread: threading.Thread | None = None
         self._lock = threading.Lock()
@@ -184,6 +186,7 @@ class JobRunner:
         """
         self.cancel(wait=True)
         self.name, self.latest, self.error, self.cancelled = name, None, "", False
+        self.trail = []
         self.started, self.finished = time.perf_counter(), 0.0
         self._cancel.clear()
         self._job_id += 1
@@ -198,6 +201,15 @@ class JobRunner:
         self._thread = threading.Thread(target=target, args=args, daemon=True,
                                         name=f"shadelab-job-{name}")
         self._thread.start()
+
+    def _publish(self, step: Progress) -> None:
+        """Make ``step`` the newest Progress (under the lock) and note it in the trail."""
+        self.latest = step
+        self.version += 1
+        if len(self.trail) < TRAIL_MAX:
+            stats = step.stats or {}
+            self.trail.append({"fraction": float(step.fraction), "level": stats.get("level"),
+                               "done": bool(stats.get("done"))})
 
     def _listen(self, job_id: int) -> None:
         """Relay the worker process's Progress; end it if a cancel does not land in time."""
@@ -218,8 +230,7 @@ class JobRunner:
                 continue  # a late message of an earlier job
             if message[0] == "progress":
                 with self._lock:
-                    self.latest = message[2]
-                    self.version += 1
+                    self._publish(message[2])
             else:
                 self.error, self.cancelled = message[2], message[3]
                 break
@@ -231,8 +242,7 @@ class JobRunner:
             gen = make()
             for step in gen:
                 with self._lock:
-                    self.latest = step
-                    self.version += 1
+                    self._publish(step)
                 if self._cancel.is_set():
                     self.cancelled = True
                     break
