@@ -38,6 +38,8 @@ uniform int u_light_attenuation[MAX_LIGHTS];     // ATTENUATION_NONE | _INVERSE_
 uniform vec3 u_light_c[MAX_LIGHTS];              // c1, c2, c3 of the lecture's f_att
 uniform vec2 u_light_spot[MAX_LIGHTS];           // cos(cone half-angle), falloff exponent
 uniform float u_light_S[MAX_LIGHTS];             // shadow factor S_i: 1 lit, 0 blocked
+uniform float u_terminator;                      // the mesh's terminator threshold t (shadow
+                                                 // volume pass only; 0: off)
 
 uniform vec3 u_Ia;                               // ambient intensity
 uniform float u_ambient_on;                      // 1: add Le + Ia ka Od (first pass only)
@@ -80,6 +82,16 @@ float blinn_phong_specular(vec3 n, vec3 to_light, vec3 to_eye, float shininess) 
     return dot(n, to_light) > 0.0 ? lobe : 0.0;
 }
 
+// The self-shadow part of S_i on a smooth mesh: smoothstep(t, 2t, N.L); 1 for t = 0.
+// The faces turned from the light sit in their own shadow volume while their shading normals
+// reach N.L <= t; fading to 0 there joins the two with no step (terminator_softening in
+// shading/reference.py).
+float terminator_softening(float n_dot_l, float threshold) {
+    if (threshold <= 0.0) return 1.0;
+    float x = clamp((n_dot_l - threshold) / threshold, 0.0, 1.0);
+    return x * x * (3.0 - 2.0 * x);
+}
+
 float attenuation(float distance, int mode, vec3 c) {
     float inverse_square = 1.0 / max(distance * distance, SHADING_EPS);
     float lecture = min(1.0 / max(c.x + c.y * distance + c.z * distance * distance,
@@ -109,7 +121,8 @@ vec3 shade_light(int i, vec3 position, vec3 n, vec3 to_eye, vec3 od) {
     float specular;
     if (SPECULAR_MODEL == SPECULAR_BLINN) specular = blinn_phong_specular(n, to_light, to_eye, u_n);
     else specular = phong_specular(n, to_light, to_eye, u_n);
-    vec3 scale = u_light_S[i] * f_att * spot * u_light_Ip[i];
+    float s = u_light_S[i] * terminator_softening(dot(n, to_light), u_terminator);
+    vec3 scale = s * f_att * spot * u_light_Ip[i];
     return scale * (u_kd * od * lambert(n, to_light) + u_ks * u_Os * specular);
 }
 

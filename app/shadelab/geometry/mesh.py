@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -17,7 +17,7 @@ from trimesh.transformations import euler_matrix
 
 from shadelab import limits
 from shadelab.errors import ShadeLabError
-from shadelab.geometry.normals import corner_normals, face_areas, face_normals
+from shadelab.geometry.normals import corner_normals, face_areas, face_normals, terminator_threshold
 from shadelab.paths import file_problem
 from shadelab.progress import steps
 from shadelab.scene.model import LENGTH_MAX, Object, Scene
@@ -54,6 +54,11 @@ class MeshData:
     @property
     def areas(self) -> np.ndarray:
         return face_areas(self.vertices, self.faces)
+
+    @cached_property
+    def terminator(self) -> float:
+        """sin of the widest face-to-corner normal angle (see :func:`terminator_threshold`)."""
+        return terminator_threshold(self.face_normals, self.corner_normals)
 
 
 def geometry_key(obj: Object, base_dir: str) -> tuple:

@@ -117,3 +117,22 @@ def corner_normals(vertices: np.ndarray, faces: np.ndarray, mode: str,
         return crease_corner_normals(vertices, faces, crease_angle_deg)
     vn = vertex_normals(vertices, faces, mode)
     return _fallback(vn[faces], fn)
+
+
+def terminator_threshold(fn: np.ndarray, cn: np.ndarray) -> float:
+    """sin(delta): delta is the widest angle between a face's normal and its corner normals.
+
+    A shading normal interpolated over a face stays within delta of the face normal, so on a
+    face turned from the light (Ng.L <= 0) it has Ns.L <= sin(delta). Stencil shadow volumes
+    put exactly those faces in shadow; the shadow pass fades the light over
+    sin(delta) <= Ns.L <= 2 sin(delta) (:func:`shadelab.shading.reference.terminator_softening`)
+    so the lit side meets the faces in the volume with no step. 0 for flat-shaded meshes.
+    """
+    if len(fn) == 0:
+        return 0.0
+    cosine = np.einsum("fk,fck->fc", fn, cn)
+    worst = float(cosine.min())
+    if worst <= 0.0:  # a corner normal turned past 90 degrees from its face: fade fully
+        return 1.0
+    sine = float(np.sqrt(max(0.0, 1.0 - worst * worst)))
+    return sine if sine > 1e-6 else 0.0   # flat faces up to rounding (a rotated box: 1e-8)

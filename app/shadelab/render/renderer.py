@@ -273,7 +273,9 @@ class Renderer:
             for variant in self.variants(shading):
                 self.set_frame_uniforms(variant, scene, view, specular, [light])
                 set_uniform(variant, "u_ambient_on", 0.0)
-            self.draw_objects(scene, opaque, shading)
+            self.draw_objects(scene, opaque, shading, terminator=True)
+            for variant in self.variants(shading):   # this light's variant: fade off again
+                set_uniform(variant, "u_terminator", 0.0)
         shadows.stencil_off()
         self.use_lights(lights, specular)
         self.ctx.depth_func = "<"
@@ -302,9 +304,16 @@ class Renderer:
         target.fbo.depth_mask = True
         target.fbo.use()
 
-    def draw_objects(self, scene: Scene, gpu_meshes: list[GpuMesh], shading: str) -> None:
+    def draw_objects(self, scene: Scene, gpu_meshes: list[GpuMesh], shading: str,
+                     terminator: bool = False) -> None:
+        """Draw each mesh with its material; ``terminator`` (the shadow-volume lit pass) sets
+        each smooth mesh's terminator threshold, which fades S_i where N.L nears it."""
+        soften = terminator and shading != "flat"   # flat: N = Ng, nothing to join
         for gpu in gpu_meshes:
             program_name = self.use_material(scene, gpu.mesh.material, shading)
+            if terminator:
+                set_uniform(self.programs[program_name], "u_terminator",
+                            gpu.mesh.terminator if soften else 0.0)
             self.vao(gpu, program_name).render(moderngl.TRIANGLES)
 
     def release(self) -> None:

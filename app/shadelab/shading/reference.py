@@ -179,10 +179,25 @@ def _material_arrays(material: Material, od: np.ndarray | None, shape: tuple):
     return np.broadcast_to(od_arr, shape + (3,)), np.asarray(material.Os, dtype=np.float64)
 
 
+def terminator_softening(n_dot_l: np.ndarray, threshold: float) -> np.ndarray:
+    """The self-shadow part of S_i on a smooth mesh: smoothstep(t, 2t, N.L), t = ``threshold``.
+
+    Shadow volumes follow the faces: a face turned from the light is inside its own volume
+    (S_i = 0) while its interpolated normal can still see the light, up to N.L = t = sin(delta)
+    (:func:`shadelab.geometry.normals.terminator_threshold`). Fading the light to 0 at N.L = t
+    joins the lit side to those faces with no step; t = 0 (flat meshes) leaves S_i = 1.
+    """
+    n_dot_l = np.asarray(n_dot_l, dtype=np.float64)
+    if threshold <= 0.0:
+        return np.ones(n_dot_l.shape)
+    x = np.clip((n_dot_l - threshold) / threshold, 0.0, 1.0)
+    return x * x * (3.0 - 2.0 * x)
+
+
 def shade_terms(position: np.ndarray, normal: np.ndarray, eye: np.ndarray, material: Material,
                 lights: list[Light], Ia, specular: str = "phong",
                 shadow: list[np.ndarray] | None = None,
-                od: np.ndarray | None = None) -> ShadeTerms:
+                od: np.ndarray | None = None, terminator: float = 0.0) -> ShadeTerms:
     """Every term of the lecture's equation at each point.
 
     Parameters
@@ -196,6 +211,8 @@ def shade_terms(position: np.ndarray, normal: np.ndarray, eye: np.ndarray, mater
     specular : "phong" for (R.V)^n or "blinn" for (N.H)^n
     shadow : one S_i array (...) per light, 1 = lit; default all lit
     od : (..., 3) optional per-point diffuse color (textures), replacing material.Od
+    terminator : the mesh's terminator threshold t (shadow volumes on); S_i is multiplied by
+        :func:`terminator_softening` (N.L_i, t). 0 (the default): no softening
 
     Notes
     -----
@@ -222,6 +239,8 @@ def shade_terms(position: np.ndarray, normal: np.ndarray, eye: np.ndarray, mater
         else:
             spot = np.ones(shape)
         s = np.ones(shape) if shadow is None else np.broadcast_to(shadow[i], shape)
+        if terminator > 0.0:
+            s = s * terminator_softening(np.sum(n * to_light, axis=-1), terminator)
         scale = (s * f_att * spot)[..., None] * np.asarray(light.Ip, dtype=np.float64)
         diffuse = scale * material.kd * od_arr * lambert(n, to_light)[..., None]
         spec = scale * material.ks * os_arr * spec_fn(n, to_light, to_eye, material.n)[..., None]
@@ -233,11 +252,13 @@ def shade_terms(position: np.ndarray, normal: np.ndarray, eye: np.ndarray, mater
 
 def shade(position: np.ndarray, normal: np.ndarray, eye: np.ndarray, material: Material,
           lights: list[Light], Ia, specular: str = "phong",
-          shadow: list[np.ndarray] | None = None, od: np.ndarray | None = None) -> np.ndarray:
+          shadow: list[np.ndarray] | None = None, od: np.ndarray | None = None,
+          terminator: float = 0.0) -> np.ndarray:
     """The lecture's illumination I (..., 3) at each point; see :func:`shade_terms`.
 
     Notes
     -----
     I = Ia ka Od + sum_i S_i f_att,i Ip,i [kd Od (N.L_i) + ks Os (R_i.V)^n]
     """
-    return shade_terms(position, normal, eye, material, lights, Ia, specular, shadow, od).total
+    return shade_terms(position, normal, eye, material, lights, Ia, specular, shadow, od,
+                       terminator).total
