@@ -42,3 +42,57 @@ def test_validation_and_meshes_go_through_steps(monkeypatch):
     scene_meshes(scene)
     n = len(scene.objects)
     assert ("validating objects", n) in seen and ("meshes and normals", n) in seen
+
+
+def test_one_long_step_ticks_its_elapsed_time_then_clears_the_line(capsys, monkeypatch):
+    monkeypatch.setattr(progress, "SHOW_STEPS", True)
+    monkeypatch.setattr(progress, "STEP_DELAY_S", 0.1)
+    monkeypatch.setattr(progress, "TICK_S", 0.05)
+    with progress.busy("reading quick.obj"):
+        pass
+    assert capsys.readouterr().err == ""                  # under the delay: nothing
+    with progress.busy("reading huge.obj"):
+        time.sleep(0.5)
+    err = capsys.readouterr().err
+    lines = [part for part in err.split("\r") if part.strip()]
+    assert len(lines) >= 3 and all(part.startswith("reading huge.obj ... ") for part in lines)
+    seconds = [float(part.split("... ")[1].split(" s")[0]) for part in lines]
+    assert seconds == sorted(seconds) and 0.1 <= seconds[0] < seconds[-1] <= 0.6
+    assert err.endswith("\r") and err.rsplit("\r", 2)[-2].strip() == ""   # line cleared
+
+
+def test_busy_is_silent_outside_the_cli_and_passes_errors_through(capsys, monkeypatch):
+    import pytest
+
+    monkeypatch.setattr(progress, "SHOW_STEPS", False)
+    with progress.busy("x"):
+        time.sleep(0.01)
+    monkeypatch.setattr(progress, "SHOW_STEPS", True)
+    with pytest.raises(ValueError, match="boom"):
+        with progress.busy("y"):
+            raise ValueError("boom")
+    assert capsys.readouterr().err == ""
+
+
+def test_mesh_file_reading_goes_through_busy(monkeypatch, tmp_path):
+    from shadelab.geometry import mesh as mesh_module
+    from shadelab.scene import load_preset
+
+    seen = []
+
+    class Spy:
+        def __init__(self, desc):
+            seen.append(desc)
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            return False
+
+    monkeypatch.setattr(mesh_module, "busy", Spy)
+    (tmp_path / "tri.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    scene = load_preset("shadows", ["objects.2.shape=mesh", f"objects.2.path={tmp_path}/tri.obj"])
+    mesh_module.scene_meshes(scene)
+    assert any("reading 'tri.obj'" in d for d in seen)
+    assert any("triangles' normals" in d for d in seen)

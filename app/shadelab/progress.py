@@ -9,6 +9,10 @@ so the viewer's Cancel button feels immediate). Pure module: no GL, no GUI.
 
 from __future__ import annotations
 
+import sys
+import threading
+import time
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Iterator
 
@@ -63,3 +67,41 @@ def steps(items, total: int | None = None, desc: str = ""):
 
     return tqdm(items, total=total, desc=desc, delay=STEP_DELAY_S, leave=False,
                 mininterval=0.5, dynamic_ncols=True)
+
+
+TICK_S = 0.5            # how often a busy line redraws its elapsed time
+
+
+@contextmanager
+def busy(desc: str):
+    """One long step with no parts to count (reading one huge mesh file, building its normals):
+    after STEP_DELAY_S a line ``desc ... 12.5 s`` on stderr ticks until the step ends, then it
+    is cleared (CLI only; nothing for short steps)."""
+    if not SHOW_STEPS:
+        yield
+        return
+    done = threading.Event()
+    start = time.perf_counter()
+
+    def tick() -> None:
+        if done.wait(STEP_DELAY_S):
+            return
+        stream = sys.stderr
+        width = 0
+        while True:
+            line = f"{desc} ... {time.perf_counter() - start:.1f} s"
+            width = max(width, len(line))
+            stream.write("\r" + line.ljust(width))
+            stream.flush()
+            if done.wait(TICK_S):
+                break
+        stream.write("\r" + " " * width + "\r")
+        stream.flush()
+
+    ticker = threading.Thread(target=tick, daemon=True, name="shadelab-busy")
+    ticker.start()
+    try:
+        yield
+    finally:
+        done.set()
+        ticker.join()

@@ -19,7 +19,7 @@ from shadelab import limits
 from shadelab.errors import ShadeLabError
 from shadelab.geometry.normals import corner_normals, face_areas, face_normals, terminator_threshold
 from shadelab.paths import file_problem
-from shadelab.progress import steps
+from shadelab.progress import busy, steps
 from shadelab.scene.model import LENGTH_MAX, Object, Scene
 
 MESH_SUFFIXES = (".obj", ".ply", ".stl", ".gltf", ".glb", ".off")
@@ -104,8 +104,9 @@ def _cached_mesh(key: tuple, shape: str, index: int):
     vertices = vertices @ matrix[:3, :3].T + matrix[:3, 3]
     if np.linalg.det(matrix[:3, :3]) < 0.0:  # a mirroring scale flips the winding back
         faces = faces[:, ::-1].copy()
-    fn = face_normals(vertices, faces)
-    cn = corner_normals(vertices, faces, obj.normals, obj.crease_angle)
+    with busy(f"objects.{index}: {len(faces)} triangles' normals"):
+        fn = face_normals(vertices, faces)
+        cn = corner_normals(vertices, faces, obj.normals, obj.crease_angle)
     for array in (vertices, faces, uvs, fn, cn):
         array.setflags(write=False)
     return vertices, faces, uvs, fn, cn
@@ -220,7 +221,8 @@ def load_mesh_file(path: str, base_dir: str, key: str) -> trimesh.Trimesh:
     limits.check(f"{key}: '{full.name}'", size, limits.MAX_MESH_FILE_BYTES, "bytes",
                  memory_bytes=8.0 * size)  # trimesh's arrays and its text parse
     try:
-        mesh = trimesh.load(str(full), force="mesh", process=False)
+        with busy(f"{key}: reading '{full.name}'"):
+            mesh = trimesh.load(str(full), force="mesh", process=False)
     except Exception as exc:  # trimesh raises many types for corrupt files
         raise ShadeLabError(f"{key}: '{full.name}' could not be read as a mesh ({exc})") from None
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
