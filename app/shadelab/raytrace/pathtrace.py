@@ -12,19 +12,29 @@ radiant intensity pi Ip for the diffuse BRDF rho / pi, so a path tracer's first 
 the raster and Whitted images and everything after it is global illumination. A light marked
 ``stand_in`` (the Cornell box's point light for its ceiling quad) is skipped: the emitting
 surface it stands for lights the paths. Ideal mirrors (``Material.mirror``) and glass
-(``kt``, Fresnel reflection or Snell refraction) are delta lobes; the ks highlight appears in
-the delta lights' direct term, not as a sampled lobe.
+(``kt``, Fresnel reflection or Snell refraction) are delta lobes. The ks highlight is also a
+sampled glossy lobe: the BRDF f_s = ks Os lobe / (pi cos theta_i), lobe = (R.wi)^n or
+(N.H)^n after ``render.specular``, the one whose delta-light term is exactly the lecture's
+ks Os (R.V)^n (:mod:`shadelab.raytrace.glossy`: its normalization, albedo and pdfs), so
+the area light's highlight and glossy inter-reflection come from the same BRDF as the delta
+lights' highlight. With ``kr`` unset (``Material.mirror`` = ks, the ray tracer's reading of
+the lecture) a material keeps its mirror lobe beside the glossy one; ``kr = 0`` makes it
+glossy only.
 
 Estimator (per path vertex, all paths of a bounce as one numpy batch, rays cast by Embree):
 
 - next-event estimation: one emitter point sampled by area over all emitting triangles
   (pdf d^2 / (cos_y A_total) in solid angle), when visible;
-- a lobe picked with probability proportional to mean(rho), kr and kt; the diffuse lobe
-  samples cos-weighted directions (weight rho / P);
-- multiple importance sampling (balance heuristic) between the two for emitters reached
-  after a diffuse bounce; after a mirror or glass bounce (and from the camera) Le counts
-  in full. MIS tames the 1/d^2 spikes of light sampling in corners, where plain NEE's
-  heavy-tailed estimates make finite-sample means run low;
+- a lobe picked with probability proportional to mean(rho), the glossy lobe's albedo at
+  normal incidence (:func:`shadelab.raytrace.glossy.lobe_weight`), kr and kt; the diffuse
+  lobe samples cos-weighted directions (weight rho / P), the glossy lobe cos^n about R (or
+  the half vector about N) (weight ks Os (f_s cos / pdf) / P);
+- multiple importance sampling (balance heuristic) between the two, lobe by lobe: the
+  diffuse and glossy parts of next-event estimation each against their own lobe's pdf
+  (times P), and emitters reached after a diffuse or glossy bounce; after a mirror or glass
+  bounce (and from the camera) Le counts in full. MIS tames the 1/d^2 spikes of light
+  sampling in corners, where plain NEE's heavy-tailed estimates make finite-sample means run
+  low;
 - Russian roulette from the fourth vertex, survival min(max(beta), 0.95);
 - a ray that leaves the scene sees ``render.background`` as a constant environment
   radiance (not light-sampled; black in the Cornell presets).
@@ -40,10 +50,11 @@ from typing import Iterator
 
 import numpy as np
 
+from shadelab.constants import SHADING_EPS as EPS
 from shadelab.constants import T_INF
 from shadelab.errors import ShadeLabError
 from shadelab.progress import Progress
-from shadelab.raytrace import kernels
+from shadelab.raytrace import glossy, kernels
 from shadelab.raytrace.accel import Hits, embree_available
 from shadelab.raytrace.surface import TraceContext, reflect_refract
 from shadelab.raytrace.whitted import stratified_jitter
@@ -105,15 +116,57 @@ def _basis(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return t, bt
 
 
+def _directions_about(axis: np.ndarray, r1: np.ndarray, r2: np.ndarray) -> np.ndarray:
+    """Unit directions about unit axes (N, 3) at cos(theta) = sqrt(1 - r1), phi = 2 pi r2:
+    cosine-weighted for uniform r1 (pass 1 - cos^2 for another polar angle)."""
+    r = np.sqrt(r1)
+    phi = 2.0 * np.pi * r2
+    x, y, z = r * np.cos(phi), r * np.sin(phi), np.sqrt(np.maximum(1.0 - r1, 0.0))
+    t, bt = _basis(axis)
+    return x[:, None] * t + y[:, None] * bt + z[:, None] * axis
+
+
 def cosine_directions(n: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     """Unit directions about unit normals n (N, 3), pdf cos(theta) / pi."""
     m = len(n)
     r1, r2 = rng.random(m), rng.random(m)
-    r = np.sqrt(r1)
-    phi = 2.0 * np.pi * r2
-    x, y, z = r * np.cos(phi), r * np.sin(phi), np.sqrt(np.maximum(1.0 - r1, 0.0))
-    t, bt = _basis(n)
-    return x[:, None] * t + y[:, None] * bt + z[:, None] * n
+    return _directions_about(n, r1, r2)
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.einsum("ij,ij->i", a, b)
+
+
+def glossy_lobe_pdf(wi: np.ndarray, n: np.ndarray, v: np.ndarray, shininess: np.ndarray,
+                    blinn: bool) -> tuple[np.ndarray, np.ndarray]:
+    """lobe(wi) ((R.wi)^n or (N.H)^n, the direct term's guards) and the glossy lobe's pdf of
+    wi (solid angle), for unit wi, n, v (N, 3): numpy twin of :func:`glossy.lobe_pdf`."""
+    if blinn:
+        h = wi + v
+        hl = np.linalg.norm(h, axis=1)
+        ok = hl > EPS
+        h = h / np.where(ok, hl, 1.0)[:, None]
+        c, vh = np.where(ok, _dot(n, h), 0.0), _dot(v, h)
+        ok &= vh > 0.0
+        scale = np.where(ok, 1.0 / (4.0 * np.where(ok, vh, 1.0)), 0.0)
+    else:
+        c, scale = _dot(2.0 * _dot(n, v)[:, None] * n - v, wi), 1.0
+    lobe = np.where(c > 0.0, np.maximum(c, EPS) ** shininess, 0.0)
+    return lobe, (shininess + 1.0) / (2.0 * np.pi) * lobe * scale
+
+
+def glossy_directions(n: np.ndarray, v: np.ndarray, shininess: np.ndarray, blinn: bool,
+                      u1: np.ndarray, u2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Directions from the glossy lobe and their f_s cos / pdf per unit ks Os (0: V.H <= 0):
+    numpy twin of :func:`glossy.sample_lobe`."""
+    cos_a = u1 ** (1.0 / (shininess + 1.0))
+    u_disk = 1.0 - cos_a * cos_a
+    if blinn:
+        h = _directions_about(n, u_disk, u2)
+        vh = _dot(v, h)
+        return 2.0 * vh[:, None] * h - v, 8.0 * np.maximum(vh, 0.0) / (shininess + 1.0)
+    axis = 2.0 * _dot(n, v)[:, None] * n - v
+    return _directions_about(axis, u_disk, u2), 2.0 / (shininess + 1.0)
 
 
 class PathTracer:
@@ -129,6 +182,11 @@ class PathTracer:
         self.kt = np.array([m.kt for m in mats], float)
         self.ior = np.array([m.ior for m in mats], float)
         self.emission = np.array([m.emission for m in mats], float).reshape(-1, 3)
+        # The glossy lobe (shadelab.raytrace.glossy): ks Os, n, and its lobe-choice weight
+        self.blinn = self.ctx.specular == "blinn"
+        self.ks_os = np.array([np.multiply(m.ks, m.Os) for m in mats], float).reshape(-1, 3)
+        self.shininess = np.array([m.n for m in mats], float)
+        self.p_glossy = glossy.lobe_weight(self.ks_os.mean(axis=1), self.shininess, self.blinn)
         self.emitters = Emitters(self.ctx, self.emission)
         # The lecture's delta lights (all but stand-ins), with a material table without the
         # ambient and emission terms: those are counted by the paths themselves.
@@ -163,9 +221,11 @@ class PathTracer:
             if textured is not None:
                 idx, od = textured
                 rho[idx] = self.kd[mat[idx], None] * od
-            p_diffuse = rho.mean(axis=1) / np.maximum(
-                rho.mean(axis=1) + self.kr[mat] + self.kt[mat], 1e-300)
-            _add(out, pixel, beta * self._next_event(surf, rho, p_diffuse, rng))
+            total = rho.mean(axis=1) + self.kr[mat] + self.kt[mat] + self.p_glossy[mat]
+            p_diffuse = rho.mean(axis=1) / np.maximum(total, 1e-300)
+            p_glossy = self.p_glossy[mat] / np.maximum(total, 1e-300)
+            _add(out, pixel, beta * self._next_event(surf, d, mat, rho, p_diffuse, p_glossy,
+                                                     rng))
             # Pick a lobe and continue the path
             o, d, beta, alive, bsdf_pdf = self._scatter(surf, d, mat, rho, beta, rng)
             if bounce >= RR_START:
@@ -179,7 +239,8 @@ class PathTracer:
 
     def _radiance_kernel(self, origins: np.ndarray, dirs: np.ndarray,
                          rng: np.random.Generator) -> np.ndarray:
-        """:meth:`radiance` with each path vertex in one numba call (same estimator)."""
+        """:meth:`radiance` with each path vertex in one numba call (same estimator,
+        :func:`shadelab.raytrace.glossy.path_vertex`)."""
         ctx, n, em = self.ctx, len(origins), self.emitters
         out = np.zeros((n, 3))
         beta = np.ones((n, 3))
@@ -194,13 +255,13 @@ class PathTracer:
             if self.delta_lights:
                 kernels.add_rows(out, pixel, beta * self._delta_lights(surf, d, mat, textured),
                                  np.ones(len(pixel), np.bool_))
-            mat, tables = self._textured_tables(mat, textured)
+            mat, tables, lobes = self._textured_tables(mat, textured)
             (nee_o, nee_d, nee_t, nee_ok, nee_val, o, d, beta, bsdf_pdf,
-             alive) = kernels.path_vertex(
+             alive) = glossy.path_vertex(
                 out, pixel, beta, bsdf_pdf, surf.position, surf.normal, surf.geo_normal,
-                surf.entering, np.ascontiguousarray(d), t, mat, tables,
+                surf.entering, np.ascontiguousarray(d), t, mat, tables, lobes,
                 (em.cdf, em.p0, em.e1, em.e2, em.normal, em.le, float(em.total_area)),
-                ctx.eps, rng.random((len(t), 7)), bounce >= RR_START)
+                ctx.eps, rng.random((len(t), 7)), bounce >= RR_START, self.blinn)
             cand = np.flatnonzero(nee_ok)
             if len(cand):
                 blocked = ctx.accel.occluded(nee_o[cand], nee_d[cand], nee_t[cand],
@@ -252,18 +313,21 @@ class PathTracer:
         return (np.concatenate([i for i, _ in parts]), np.concatenate([o for _, o in parts]))
 
     def _textured_tables(self, mat: np.ndarray, textured):
-        """Material tables with one extra row per textured hit (its kd Od(u, v)), and the hits'
-        material indices pointing at those rows: the kernels stay per-material."""
+        """Material tables (rho, kr, kt, ior, emission) and glossy-lobe tables (ks Os, n,
+        weight) with one extra row per textured hit (its kd Od(u, v)), and the hits' material
+        indices pointing at those rows: the kernels stay per-material."""
         tables = (self.rho, self.kr, self.kt, self.ior, self.emission)
+        lobes = (self.ks_os, self.shininess, self.p_glossy)
         if textured is None:
-            return mat, tables
+            return mat, tables, lobes
         idx, od = textured
         base = mat[idx]
         rows = len(self.rho)
         mat = mat.copy()
         mat[idx] = rows + np.arange(len(idx))
         rho = np.concatenate([self.rho, self.kd[base, None] * od])
-        return mat, (rho, *(np.concatenate([t, t[base]]) for t in tables[1:]))
+        return (mat, (rho, *(np.concatenate([t, t[base]]) for t in tables[1:])),
+                tuple(np.concatenate([t, t[base]]) for t in lobes))
 
     def _delta_lights(self, surf, d: np.ndarray, mat: np.ndarray,
                       textured=None) -> np.ndarray:
@@ -302,7 +366,7 @@ class PathTracer:
 
     def _emitted(self, surf, d: np.ndarray, t: np.ndarray, mat: np.ndarray,
                  bsdf_pdf: np.ndarray) -> np.ndarray:
-        """Le at the hits, MIS-weighted (balance heuristic) after a diffuse bounce."""
+        """Le at the hits, MIS-weighted (balance heuristic) after a diffuse or glossy bounce."""
         le = self.emission[mat]
         weight = np.ones(len(t))
         mis = np.flatnonzero((bsdf_pdf > 0.0) & (le.max(axis=1) > 0.0))
@@ -312,17 +376,19 @@ class PathTracer:
             weight[mis] = bsdf_pdf[mis] / (bsdf_pdf[mis] + light_pdf)
         return le * weight[:, None]
 
-    def _next_event(self, surf, rho: np.ndarray, p_diffuse: np.ndarray,
+    def _next_event(self, surf, d: np.ndarray, mat: np.ndarray, rho: np.ndarray,
+                    p_diffuse: np.ndarray, p_glossy: np.ndarray,
                     rng: np.random.Generator) -> np.ndarray:
-        """Direct light from one emitter point per path vertex (diffuse part only), MIS-weighted.
+        """Direct light from one emitter point per path vertex, MIS-weighted lobe by lobe.
 
-        f Le cos_x / (pdf_light + pdf_bsdf), pdf_light = d^2 / (cos_y A_total) and
-        pdf_bsdf = P(diffuse lobe) cos_x / pi (the balance heuristic).
+        f Le cos_x / (pdf_light + pdf_bsdf) per lobe, pdf_light = d^2 / (cos_y A_total) and
+        pdf_bsdf = P(diffuse lobe) cos_x / pi for f = rho / pi, P(glossy lobe) pdf_glossy for
+        f_s (the balance heuristic).
         """
         m = len(rho)
         out = np.zeros((m, 3))
         em = self.emitters
-        idx = np.flatnonzero(rho.max(axis=1) > 0.0)
+        idx = np.flatnonzero((rho.max(axis=1) > 0.0) | (p_glossy > 0.0))
         if em.count == 0 or len(idx) == 0:
             return out
         points, normals, le = em.sample(rng, len(idx))
@@ -346,20 +412,29 @@ class PathTracer:
         bsdf_pdf = p_diffuse[idx[vis]] * cos_x[vis] / np.pi
         scale = cos_x[vis] / (light_pdf + bsdf_pdf)
         out[idx[vis]] = (rho[idx[vis]] / np.pi) * le[vis] * scale[:, None]
+        g = np.flatnonzero(p_glossy[idx[vis]] > 0.0)  # f_s cos = ks Os lobe / pi
+        if len(g):
+            at, mg = idx[vis[g]], mat[idx[vis[g]]]
+            lobe, pdf = glossy_lobe_pdf(wi[vis[g]], n[vis[g]], -d[at], self.shininess[mg],
+                                        self.blinn)
+            out[at] += self.ks_os[mg] * le[vis[g]] * (
+                lobe / np.pi / (light_pdf[g] + p_glossy[at] * pdf))[:, None]
         return out
 
     def _scatter(self, surf, d: np.ndarray, mat: np.ndarray, rho: np.ndarray,
                  beta: np.ndarray, rng: np.random.Generator):
         """New origins, directions and throughputs after one lobe choice per path."""
         m = len(d)
-        p_d, p_r, p_t = rho.mean(axis=1), self.kr[mat], self.kt[mat]
-        total = p_d + p_r + p_t
+        p_d, p_r, p_t, p_s = rho.mean(axis=1), self.kr[mat], self.kt[mat], self.p_glossy[mat]
+        total = p_d + p_r + p_t + p_s
         u = rng.random(m) * total
         diffuse = u < p_d
-        mirror = ~diffuse & (u < p_d + p_r)
-        glass = ~diffuse & ~mirror & (total > 0.0)
+        shiny = ~diffuse & (p_s > 0.0) & (u < p_d + p_s)
+        mirror = ~diffuse & ~shiny & (u < p_d + p_s + p_r)
+        glass = ~diffuse & ~shiny & ~mirror & (total > 0.0)
         alive = total > 0.0
-        prob = np.where(diffuse, p_d, np.where(mirror, p_r, p_t)) / np.maximum(total, 1e-300)
+        prob = np.where(diffuse, p_d, np.where(shiny, p_s, np.where(mirror, p_r, p_t))
+                        ) / np.maximum(total, 1e-300)
         new_d = np.empty_like(d)
         weight = np.zeros((m, 3))
         # Diffuse: cosine-weighted, f cos / pdf = rho
@@ -379,12 +454,22 @@ class PathTracer:
         weight[i] = self.kt[mat[i]][:, None]
         through = np.zeros(m, bool)
         through[i] = ~reflect
+        # Glossy: the lobe about R (or H about N), f_s cos / pdf = ks Os weight
+        g = np.flatnonzero(shiny)
+        u1, u2 = rng.random(len(g)), rng.random(len(g))
+        v, n, ng = -d[g], surf.normal[g], surf.geo_normal[g]
+        new_d[g], w = glossy_directions(n, v, self.shininess[mat[g]], self.blinn, u1, u2)
+        weight[g] = self.ks_os[mat[g]] * np.broadcast_to(w, len(g))[:, None]
+        alive[g] &= (np.broadcast_to(w, len(g)) > 0.0) & (_dot(new_d[g], ng) > 0.0) \
+            & (_dot(new_d[g], n) > 0.0)
         side = np.where(through, -1.0, 1.0) * self.ctx.eps
         origins = surf.position + side[:, None] * surf.geo_normal
         beta = beta * weight / np.maximum(prob, 1e-300)[:, None]
         bsdf_pdf = np.zeros(m)
         i = np.flatnonzero(diffuse)
         bsdf_pdf[i] = prob[i] * np.einsum("ij,ij->i", new_d[i], surf.normal[i]) / np.pi
+        bsdf_pdf[g] = prob[g] * glossy_lobe_pdf(new_d[g], n, v, self.shininess[mat[g]],
+                                                self.blinn)[1]
         return origins, new_d, beta, alive, bsdf_pdf
 
 
