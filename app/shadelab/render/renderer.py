@@ -7,7 +7,7 @@ that changes a coefficient re-sets uniforms only; nothing is re-uploaded.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import moderngl
 import numpy as np
@@ -262,20 +262,22 @@ class Renderer:
         be evaluated and multiplied by S_i = 0: the same sum, m times the shading work)."""
         shadows = self.shadow_volumes
         shadows.drop_lights_from(len(lights))
+        method = scene.render.shadow_method
         for index, light in enumerate(lights):
             volumes = shadows.volumes(scene, gpu_meshes, index, light)
-            shadows.count(target, view, volumes, scene.render.shadow_method)
-            self.ctx.enable_only(moderngl.DEPTH_TEST | moderngl.BLEND)
-            self.ctx.blend_func = moderngl.ONE, moderngl.ONE
-            self.ctx.depth_func = "<="
-            shadows.lit_where_zero()
-            self.use_lights([light], specular)
-            for variant in self.variants(shading):
-                self.set_frame_uniforms(variant, scene, view, specular, [light])
-                set_uniform(variant, "u_ambient_on", 0.0)
-            self.draw_objects(scene, opaque, shading, terminator=True)
-            for variant in self.variants(shading):   # this light's variant: fade off again
-                set_uniform(variant, "u_terminator", 0.0)
+            passes = self._stencil_for_light(scene, target, view, volumes, method, light)
+            for ref, lit in passes:
+                self.ctx.enable_only(moderngl.DEPTH_TEST | moderngl.BLEND)
+                self.ctx.blend_func = moderngl.ONE, moderngl.ONE
+                self.ctx.depth_func = "<="
+                shadows.lit_where_zero(ref)
+                self.use_lights([lit], specular)
+                for variant in self.variants(shading):
+                    self.set_frame_uniforms(variant, scene, view, specular, [lit])
+                    set_uniform(variant, "u_ambient_on", 0.0)
+                self.draw_objects(scene, opaque, shading, terminator=True)
+                for variant in self.variants(shading):   # this light's variant: fade off again
+                    set_uniform(variant, "u_terminator", 0.0)
         shadows.stencil_off()
         self.use_lights(lights, specular)
         self.ctx.depth_func = "<"
@@ -285,6 +287,53 @@ class Renderer:
         for variant in self.variants(shading):
             write_light_uniforms(variant, lights)
             set_uniform(variant, "u_ambient_on", 1.0)
+
+    def _stencil_for_light(self, scene: Scene, target: RenderTarget, view: View, volumes,
+                           method: str, light: Light) -> list[tuple[int, Light]]:
+        """Fill the stencil for one light; return its lit passes as (stencil value, light).
+
+        Opaque casters only: the volume count, one pass where it is 0 (S_i = 1). With
+        transparent casters (kt > 0) S_i is kt-filtered as in the ray tracer: each of the
+        first FILTER_SLOTS gets a flag bit where the surface is inside its volume, the opaque
+        casters count in the low bits, and one pass per combination of flags adds the light
+        with Ip scaled by the product of those casters' transmittance: the shadow_filter
+        kt Ot (kt alone, interpolated model) once for an open caster (a pane), squared for a
+        closed one (the shadow ray enters and leaves it).
+        """
+        from itertools import product
+
+        from shadelab.render.shadows import COUNTER_MASK, FILTER_SLOTS, filter_bit
+        from shadelab.shading.reference import shadow_filter
+
+        shadows = self.shadow_volumes
+        clear = [v for v in volumes
+                 if is_transparent(scene.materials[scene.objects[v.object_index].material])]
+        if not clear:
+            shadows.count(target, view, volumes, method)
+            return [(0, light)]
+        filters = clear[:FILTER_SLOTS]       # further transparent casters cast no shadow
+        opaque = [v for v in volumes if v not in clear]
+        shadows.count(target, view, [], method)                  # every bit to 0
+        for slot, caster in enumerate(filters):
+            shadows.flag_inside(target, view, caster, method, slot)
+        shadows.count(target, view, opaque, method, field=COUNTER_MASK)
+        factors = []
+        for caster in filters:
+            material = scene.materials[scene.objects[caster.object_index].material]
+            crossings = 2 if caster.volume.method == "silhouette" else 1
+            factors.append(shadow_filter(material) ** crossings)
+        passes = []
+        for inside in product((False, True), repeat=len(filters)):
+            ref = sum(filter_bit(slot) for slot, on in enumerate(inside) if on)
+            scale = np.ones(3)
+            for on, factor in zip(inside, factors, strict=True):
+                if on:
+                    scale = scale * factor
+            if scale.max() <= 0.0:
+                continue                                          # fully blocked: add nothing
+            passes.append((ref, replace(light, Ip=tuple(float(c) for c in
+                                                          np.asarray(light.Ip) * scale))))
+        return passes
 
     def _shadow_overlays(self, scene: Scene, target: RenderTarget, view: View, gpu_meshes,
                          lights: list[Light]) -> None:

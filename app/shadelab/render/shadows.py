@@ -27,6 +27,15 @@ OFFSET_FRACTION = 1e-3  # volumes start this share of the scene's diagonal beyon
 VOLUME_COLOR = (0.25, 0.45, 1.0, 0.18)  # translucent volumes (linear RGB, alpha)
 SILHOUETTE_COLOR = (1.0, 0.85, 0.1, 1.0)
 HEAT_LEVELS = 8  # stencil counts 1..8 get their own color; above 8 shows as 8
+# kt-filtered shadows: with transparent casters the stencil splits into a 4-bit volume counter
+# (mod 16) and one "inside caster j's volume" flag per transparent caster (bits 4..7)
+COUNTER_MASK = 0x0F
+FILTER_SLOTS = 4  # transparent casters filtered per light; further ones cast no shadow
+
+
+def filter_bit(slot: int) -> int:
+    """The stencil flag of the transparent caster in ``slot`` (0 .. FILTER_SLOTS - 1)."""
+    return 1 << (4 + slot)
 
 
 def _gl():
@@ -51,6 +60,7 @@ class CasterVolume:
 
     key: tuple
     volume: ShadowVolume
+    object_index: int
     vbo: moderngl.Buffer
     vao: moderngl.VertexArray
     line_vbo: moderngl.Buffer
@@ -93,29 +103,34 @@ class ShadowVolumes:
             if cached is None or cached.key != key:
                 if cached is not None:
                     cached.release()
-                cached = self._upload(key, shadow_volume(gpu.mesh.vertices, gpu.mesh.faces,
-                                                         homogeneous, offset))
+                cached = self._upload(key, gpu.mesh.index,
+                                      shadow_volume(gpu.mesh.vertices, gpu.mesh.faces,
+                                                    homogeneous, offset))
                 self._cache[slot] = cached
             out.append(cached)
         for slot in [s for s in self._cache if s[1] == light_index and s not in live]:
             self._cache.pop(slot).release()
         return out
 
-    def _upload(self, key: tuple, volume: ShadowVolume) -> CasterVolume:
+    def _upload(self, key: tuple, object_index: int, volume: ShadowVolume) -> CasterVolume:
         vbo = self.ctx.buffer(volume.triangles().tobytes())
         vao = self.ctx.vertex_array(self.program, [(vbo, "4f", "in_position")])
         lines = volume.vertices[volume.silhouette].astype(np.float32)
         line_vbo = self.ctx.buffer(lines.tobytes() if len(lines) else bytes(32))
         line_vao = self.ctx.vertex_array(self.program, [(line_vbo, "4f", "in_position")])
-        return CasterVolume(key, volume, vbo, vao, line_vbo, line_vao)
+        return CasterVolume(key, volume, object_index, vbo, vao, line_vbo, line_vao)
 
     def drop_lights_from(self, count: int) -> None:
         for slot in [s for s in self._cache if s[1] >= count]:
             self._cache.pop(slot).release()
 
     # ------------------------------------------------------------ passes
-    def count(self, target, view, volumes: list[CasterVolume], method: str) -> None:
-        """Stencil pass: clear the stencil and count volume faces (z-fail or z-pass)."""
+    def count(self, target, view, volumes: list[CasterVolume], method: str,
+              field: int = 0xFF) -> None:
+        """Stencil pass: clear the stencil and count volume faces (z-fail or z-pass).
+
+        ``field`` limits the clear and the count to those stencil bits (COUNTER_MASK: mod 16,
+        leaving the transparent casters' flags alone)."""
         GL = _gl()
         ctx = self.ctx
         _ = ctx.error
@@ -123,7 +138,7 @@ class ShadowVolumes:
         target.fbo.depth_mask = False
         target.fbo.use()  # applies the masks (moderngl sets them on use)
         _ = ctx.error
-        GL.glStencilMask(0xFF)
+        GL.glStencilMask(field)
         GL.glClearStencil(0)
         GL.glClear(GL.GL_STENCIL_BUFFER_BIT)
         ctx.enable_only(moderngl.DEPTH_TEST)
@@ -147,14 +162,37 @@ class ShadowVolumes:
         target.fbo.color_mask = (True, True, True, True)
         target.fbo.use()  # color writes back on; depth writes stay off until the frame ends
 
-    def lit_where_zero(self) -> None:
-        """Stencil state for the additive lit pass: draw only where the count is 0."""
+    def lit_where_zero(self, ref: int = 0) -> None:
+        """Stencil state for the additive lit pass: draw only where the stencil is ``ref``
+        (the volume count 0, and with transparent casters exactly their flags ``ref``)."""
         GL = _gl()
         _ = self.ctx.error
         GL.glEnable(GL.GL_STENCIL_TEST)
         GL.glStencilMask(0x00)
-        GL.glStencilFunc(GL.GL_EQUAL, 0, 0xFF)
+        GL.glStencilFunc(GL.GL_EQUAL, ref, 0xFF)
         GL.glStencilOp(GL.GL_KEEP, GL.GL_KEEP, GL.GL_KEEP)
+
+    def flag_inside(self, target, view, caster: CasterVolume, method: str, slot: int) -> None:
+        """Set ``filter_bit(slot)`` wherever the visible surface lies inside ``caster``'s
+        volume: count it alone in the counter bits, then turn a non-zero count into the flag
+        with a full-screen quad (color and depth untouched)."""
+        GL = _gl()
+        ctx = self.ctx
+        self.count(target, view, [caster], method, field=COUNTER_MASK)
+        target.fbo.color_mask = (False, False, False, False)
+        target.fbo.use()
+        ctx.enable_only(moderngl.NOTHING)
+        _ = ctx.error
+        GL.glEnable(GL.GL_STENCIL_TEST)
+        bit = filter_bit(slot)
+        GL.glStencilMask(bit)
+        GL.glStencilFunc(GL.GL_NOTEQUAL, bit, COUNTER_MASK)   # bit & 0x0F == 0: count != 0
+        GL.glStencilOp(GL.GL_KEEP, GL.GL_KEEP, GL.GL_REPLACE)
+        set_uniform(self.program, "u_clip_from_world", np.eye(4, dtype=np.float32).tobytes())
+        self._quad_vao.render(moderngl.TRIANGLES)
+        GL.glStencilOp(GL.GL_KEEP, GL.GL_KEEP, GL.GL_KEEP)
+        target.fbo.color_mask = (True, True, True, True)
+        target.fbo.use()
 
     def stencil_off(self) -> None:
         GL = _gl()

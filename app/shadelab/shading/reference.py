@@ -179,6 +179,13 @@ def _material_arrays(material: Material, od: np.ndarray | None, shape: tuple):
     return np.broadcast_to(od_arr, shape + (3,)), np.asarray(material.Os, dtype=np.float64)
 
 
+def shadow_filter(material: Material) -> np.ndarray:
+    """(3,) the factor one crossing of a transparent caster puts on S_i: kt Ot for the
+    "filtered" model, kt for "interpolated" (whose Ot is taken as 1); 0 for opaque ones."""
+    tint = material.Ot if material.transparency == "filtered" else (1.0, 1.0, 1.0)
+    return material.kt * np.asarray(tint, dtype=np.float64)
+
+
 def terminator_softening(n_dot_l: np.ndarray, threshold: float) -> np.ndarray:
     """The self-shadow part of S_i on a smooth mesh: smoothstep(t, 2t, N.L), t = ``threshold``.
 
