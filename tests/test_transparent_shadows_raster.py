@@ -108,3 +108,38 @@ def test_transparent_casters_past_the_slots_cast_no_shadow(gl_ctx):
     assert deepest.sum() > 100
     assert np.abs(gl - kt ** (FILTER_SLOTS + 1)).max(axis=1).min() > 1e-3
     assert gl.min() > kt.min() ** FILTER_SLOTS - 2e-3
+
+
+def _probe_against_gpu(scene, size, pixels):
+    from shadelab.render.offscreen import render_image
+    from shadelab.ui.probe import probe
+
+    image = render_image(scene, size)
+    out = []
+    for x, y in pixels:
+        result = probe(scene, size, (x, y))
+        assert result is not None
+        np.testing.assert_allclose(result.reference, image[y, x], rtol=1e-3, atol=1e-4)
+        out.append(result)
+    return out
+
+
+@pytest.mark.parametrize("shading", ["flat", "gouraud", "phong"])
+def test_the_probe_reports_the_stencil_s_i_and_matches_the_gpu(gl_ctx, shading):
+    """With shadows on, the probe's S_i is the shadow volumes' (1 lit, 0 behind the box,
+    kt-filtered behind a pane) and its reference value is the pixel the GPU drew."""
+    size = (160, 120)
+    scene = load_preset("transparency", ["render.shadows=volumes", f"render.shading={shading}"])
+    ray, position, _n, _g = pixel_surfaces(scene, 0)
+    gl, rows = _gl_shadow_factor(scene)
+    oracle = _oracle(scene, rows)
+    green = shadow_filter(scene.materials["filtered"])
+    picks = {}
+    for label, want in (("lit", np.ones(3)), ("green", green)):
+        close = np.flatnonzero((np.abs(oracle - want).max(axis=1) < 1e-9)
+                               & (np.abs(gl - want).max(axis=1) < 1e-4))
+        r = int(ray[rows[close[len(close) // 2]]])
+        picks[label] = (r % size[0], r // size[0])
+    lit, filtered = _probe_against_gpu(scene, size, [picks["lit"], picks["green"]])
+    assert float(np.asarray(lit.terms.lights[0].shadow).min()) == 1.0
+    np.testing.assert_allclose(filtered.terms.lights[0].shadow, green, rtol=1e-12)

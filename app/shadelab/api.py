@@ -335,6 +335,11 @@ def _vec(v: Any) -> tuple[float, ...]:
     return tuple(float(c) for c in np.asarray(v, dtype=np.float64).reshape(-1))
 
 
+def _shadow_value(shadow) -> float | list[float]:
+    values = np.asarray(shadow, dtype=np.float64).reshape(-1)
+    return float(values[0]) if np.ptp(values) == 0.0 else [float(v) for v in values]
+
+
 def probe(scene: Scene | str, pixel: tuple[int, int], size: Any = (800, 600),
           shading: str | None = None, specular: str | None = None) -> dict | None:
     """The lecture's terms at the surface point a pixel shows (the viewer's probe, as data).
@@ -359,7 +364,8 @@ def probe(scene: Scene | str, pixel: tuple[int, int], size: Any = (800, 600),
         ``normal`` (3,) unit N facing the viewer, ``to_eye`` (3,) unit V, ``emission`` (3,),
         ``ambient`` (3,) Ia ka Od, ``lights``: one dict per enabled light with ``to_light``
         (3,) unit L, ``reflected`` (3,) R (or H for Blinn), ``distance``, ``f_att``,
-        ``clamped`` (the lecture's min(., 1) active), ``spot``, ``shadow`` S,
+        ``clamped`` (the lecture's min(., 1) active), ``spot``, ``shadow`` S (a number, or
+        [r, g, b] where transparent casters filter it),
         ``diffuse`` (3,) and ``specular`` (3,) radiance; ``total`` (3,) the equation at the
         point and ``reference`` (3,) what the shading mode computes at this pixel (linear
         RGB, before exposure).
@@ -388,7 +394,7 @@ def probe(scene: Scene | str, pixel: tuple[int, int], size: Any = (800, 600),
         lights.append({"to_light": _vec(term.to_light), "reflected": _vec(result.reflected(i)),
                        "distance": float(term.distance), "f_att": float(term.f_att),
                        "clamped": bool(term.clamp_active), "spot": float(term.spot),
-                       "shadow": float(term.shadow), "diffuse": _vec(term.diffuse),
+                       "shadow": _shadow_value(term.shadow), "diffuse": _vec(term.diffuse),
                        "specular": _vec(term.specular)})
     return {"pixel": (x, y), "shading": result.shading, "specular": result.specular,
             "object": int(result.hit.mesh.index), "material": result.hit.mesh.material,

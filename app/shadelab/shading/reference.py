@@ -155,7 +155,7 @@ class LightTerms:
     f_att: np.ndarray         # (...) attenuation
     clamp_active: np.ndarray  # (...) bool, lecture's min(., 1) clamped to 1
     spot: np.ndarray          # (...) spot cone factor (1 for other kinds)
-    shadow: np.ndarray        # (...) S_i in [0, 1]
+    shadow: np.ndarray        # (...) S_i in [0, 1], or (..., 3) when kt-filtered per channel
     diffuse: np.ndarray       # (..., 3) S f_att spot Ip kd Od (N.L)
     specular: np.ndarray      # (..., 3) S f_att spot Ip ks Os (R.V)^n or (N.H)^n
 
@@ -216,7 +216,8 @@ def shade_terms(position: np.ndarray, normal: np.ndarray, eye: np.ndarray, mater
     lights : the enabled lights, each with its Ip, attenuation and cone
     Ia : (3,) ambient intensity
     specular : "phong" for (R.V)^n or "blinn" for (N.H)^n
-    shadow : one S_i array (...) per light, 1 = lit; default all lit
+    shadow : one S_i array (...) per light, 1 = lit, or (..., 3) per channel (the kt-filtered
+        S_i of transparent casters); default all lit
     od : (..., 3) optional per-point diffuse color (textures), replacing material.Od
     terminator : the mesh's terminator threshold t (shadow volumes on); S_i is multiplied by
         :func:`terminator_softening` (N.L_i, t). 0 (the default): no softening
@@ -245,10 +246,15 @@ def shade_terms(position: np.ndarray, normal: np.ndarray, eye: np.ndarray, mater
                                light.spot_exponent)
         else:
             spot = np.ones(shape)
-        s = np.ones(shape) if shadow is None else np.broadcast_to(shadow[i], shape)
+        s = np.ones(shape) if shadow is None else np.asarray(shadow[i], dtype=np.float64)
+        rgb = s.shape == shape + (3,) and shadow is not None   # kt-filtered S_i per channel
+        if not rgb:
+            s = np.broadcast_to(s, shape)
         if terminator > 0.0:
-            s = s * terminator_softening(np.sum(n * to_light, axis=-1), terminator)
-        scale = (s * f_att * spot)[..., None] * np.asarray(light.Ip, dtype=np.float64)
+            soft = terminator_softening(np.sum(n * to_light, axis=-1), terminator)
+            s = s * (soft[..., None] if rgb else soft)
+        s3 = s if rgb else s[..., None]
+        scale = s3 * (f_att * spot)[..., None] * np.asarray(light.Ip, dtype=np.float64)
         diffuse = scale * material.kd * od_arr * lambert(n, to_light)[..., None]
         spec = scale * material.ks * os_arr * spec_fn(n, to_light, to_eye, material.n)[..., None]
         terms.append(LightTerms(to_light, distance, f_att, attenuation_clamped(distance, light),

@@ -440,7 +440,12 @@ def draw_equation_panel(state: AppState) -> bool:
             spec_cos = float(np.dot(result.normal if blinn else result.reflected(i),
                                     result.reflected(i) if blinn else result.to_eye))
             _term_row(f"{name}: d, f_att", (float(t.distance), float(t.f_att)))
-            _term_row(f"{name}: S_i, spot", (float(t.shadow), float(t.spot)))
+            shadow = np.asarray(t.shadow, dtype=np.float64).reshape(-1)
+            if np.ptp(shadow) > 0.0:     # kt-filtered: one S_i per channel
+                _term_row(f"{name}: S_i (r, g, b)", shadow)
+                _term_row(f"{name}: spot", float(t.spot))
+            else:
+                _term_row(f"{name}: S_i, spot", (float(shadow[0]), float(t.spot)))
             _term_row(f"{name}: N.L, {'N.H' if blinn else 'R.V'}", (n_dot_l, spec_cos))
             _term_row(f"{name}: diffuse", t.diffuse)
             _term_row(f"{name}: specular", t.specular)

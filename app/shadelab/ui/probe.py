@@ -106,6 +106,28 @@ def cast_pixel(scene: Scene, size: tuple[int, int], pixel: tuple[int, int],
     return intersect(scene, meshes, origins[y, x], directions[y, x])
 
 
+def probe_shadows(scene: Scene, point: np.ndarray, geometric_normal: np.ndarray,
+                  lights) -> list[np.ndarray]:
+    """(3,) S_i per light at ``point`` as the raster's shadow volumes give it: one shadow ray
+    of the ray tracer towards the light, 1 if it gets there, 0 behind an opaque caster, the
+    product of kt Ot over the transparent casters it crosses (kt-filtered shadows)."""
+    from shadelab.constants import T_INF
+    from shadelab.raytrace.surface import TraceContext
+
+    ctx = TraceContext(scene)
+    origin = np.asarray(point, dtype=np.float64) + ctx.eps * geometric_normal
+    out = []
+    for light in lights:
+        if light.kind == "directional":
+            d, tmax = normalize(-np.asarray(light.direction, dtype=np.float64)), T_INF
+        else:
+            delta = np.asarray(light.position, dtype=np.float64) - origin
+            distance = float(np.linalg.norm(delta))
+            d, tmax = delta / max(distance, 1e-300), max(distance - ctx.eps, 0.0)
+        out.append(ctx.shadow_transmittance(origin[None], d[None], np.array([tmax]))[0])
+    return out
+
+
 def _facing(n: np.ndarray, face_normal: np.ndarray, to_eye: np.ndarray) -> np.ndarray:
     """Flip ``n`` where the face is seen from behind (the shaders' back-face rule)."""
     sign = np.where(np.sum(face_normal * to_eye, axis=-1) < 0.0, -1.0, 1.0)
@@ -131,14 +153,23 @@ def probe(scene: Scene, size: tuple[int, int], pixel: tuple[int, int], shading: 
         normal = _facing(fn, fn, to_eye)
     else:
         normal = _facing(normalize(hit.bary @ mesh.corner_normals[face]), fn, to_eye)
-    terms = shade_terms(hit.point, normal, eye, material, lights, scene.Ia, specular)
+    shadow, fade = None, 0.0
+    if scene.render.shadows == "volumes" and material.kt <= 0.0 and lights:
+        # the stencil's S_i at this pixel; transparent surfaces are drawn unshadowed
+        shadow = probe_shadows(scene, hit.point, _facing(fn, fn, to_eye), lights)
+        fade = mesh.terminator if shading != "flat" else 0.0
+    terms = shade_terms(hit.point, normal, eye, material, lights, scene.Ia, specular, shadow,
+                        terminator=fade)
     if shading == "flat":
         centroid = corners.mean(axis=0)
         n_c = _facing(fn, fn, normalize(eye - centroid))
-        reference = shade_terms(centroid, n_c, eye, material, lights, scene.Ia, specular).total
+        reference = shade_terms(centroid, n_c, eye, material, lights, scene.Ia, specular,
+                                shadow).total
     elif shading == "gouraud":
         n_v = _facing(mesh.corner_normals[face], np.broadcast_to(fn, (3, 3)), eye - corners)
-        colors = shade_terms(corners, n_v, eye, material, lights, scene.Ia, specular).total
+        at_corners = None if shadow is None else [np.broadcast_to(s, (3, 3)) for s in shadow]
+        colors = shade_terms(corners, n_v, eye, material, lights, scene.Ia, specular,
+                             at_corners, terminator=fade).total
         reference = hit.bary @ colors
     else:
         reference = terms.total
