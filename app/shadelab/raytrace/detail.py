@@ -48,6 +48,25 @@ class SceneDetail:
         dpdu, dpdv = self.tangents()
         return detail.od(uv), detail.normal(normal, dpdu[tri], dpdv[tri], uv)
 
+    def bumped(self, normal: np.ndarray, dirs: np.ndarray, mat: np.ndarray, tri: np.ndarray,
+               u: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """The normals mirror and refracted rays leave about: ``normal`` with the bumped
+        normal on bumped materials (the one :meth:`reshade` shades with), where it still faces
+        the incoming ray. ``normal`` itself when no hit is on a bumped material."""
+        out = normal
+        for m, detail in self.details.items():
+            if not detail.bump_mode:
+                continue
+            idx = np.flatnonzero(mat == m)
+            if len(idx) == 0:
+                continue
+            _, n = self.od_and_normal(m, tri[idx], u[idx], v[idx], normal[idx])
+            facing = np.einsum("ij,ij->i", n, -dirs[idx]) > 0.0
+            if out is normal:
+                out = normal.copy()
+            out[idx[facing]] = n[facing]
+        return out
+
     def reshade(self, color: np.ndarray, position: np.ndarray, normal: np.ndarray,
                 dirs: np.ndarray, mat: np.ndarray, tri: np.ndarray, u: np.ndarray,
                 v: np.ndarray, shadow) -> np.ndarray:

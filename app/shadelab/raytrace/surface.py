@@ -322,7 +322,8 @@ class TraceContext:
         n = len(dirs)
         mat = self.material_ids(surf)
         kr, kt, ior, tint = self.kr[mat], self.kt[mat], self.ior[mat], self.tint[mat]
-        refl_dir, refr_dir, tir, f = reflect_refract(dirs, surf.normal, surf.entering, ior)
+        refl_dir, refr_dir, tir, f = reflect_refract(dirs, self.spawn_normals(surf, dirs, mat),
+                                                     surf.entering, ior)
         if fresnel:
             refl_scalar = kr + kt * f
             refr_scalar = kt * (1.0 - f)
@@ -338,7 +339,8 @@ class TraceContext:
         """The next generation of rays (origins, dirs, weights, pixels) above ``min_weight``."""
         mat = self.material_ids(surf)
         if self.kernels:
-            return kernels.spawn_secondary(surf.position, surf.normal, surf.geo_normal,
+            return kernels.spawn_secondary(surf.position, self.spawn_normals(surf, dirs, mat),
+                                           surf.geo_normal,
                                            surf.entering, np.ascontiguousarray(dirs), mat,
                                            weight, pixel, self.kr, self.kt, self.ior,
                                            self.tint, fresnel, min_weight, self.eps)
@@ -351,6 +353,15 @@ class TraceContext:
         return (origins, np.concatenate([refl_dir[keep_r], refr_dir[keep_t]]),
                 np.concatenate([refl_w[keep_r], refr_w[keep_t]]),
                 np.concatenate([pixel[keep_r], pixel[keep_t]]))
+
+    def spawn_normals(self, surf: Surface, dirs: np.ndarray, mat: np.ndarray) -> np.ndarray:
+        """Shading normals for the mirror and refracted directions: bumped where the
+        material has a bump map (:meth:`SceneDetail.bumped`), else ``surf.normal``."""
+        if not self.detail.active or surf.hits is None:
+            return surf.normal
+        h = surf.hits
+        return self.detail.bumped(surf.normal, np.asarray(dirs, dtype=np.float64), mat, h.tri,
+                                  h.u, h.v)
 
     def offset_origin(self, surf: Surface, idx: np.ndarray, outward: bool) -> np.ndarray:
         """Origins moved off the surface by eps, to the incoming side (or through it)."""

@@ -218,6 +218,9 @@ def _trace_batch_kernels(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarra
         # Spawn the reflected and refracted generation (into the other set of buffers)
         new_o, new_d = ws.get("next_o", 2 * k, 3), ws.get("next_d", 2 * k, 3)
         new_w, new_p = ws.get("next_w", 2 * k, 3), ws.get("next_p", 2 * k, 0, np.int64)
+        if ctx.detail.active:  # mirror and refracted rays leave about the bumped normal
+            normal = ctx.detail.bumped(normal, d, mat, tri[hit], np.asarray(u[hit], np.float64),
+                                       np.asarray(v[hit], np.float64))
         count = kernels.spawn_secondary_into(new_o, new_d, new_w, new_p, position, normal, geo,
                                              entering, d, mat, w, px, ctx.kr, ctx.kt, ctx.ior,
                                              ctx.tint, fresnel, min_weight, ctx.eps)
