@@ -93,3 +93,19 @@ def test_per_triangle_caps_keep_their_gap_at_grazing_light_and_rays_stay_put():
     d_new = (near - light[:3]) / np.linalg.norm(near - light[:3], axis=1, keepdims=True)
     d_old = (quad - light[:3]) / np.linalg.norm(quad - light[:3], axis=1, keepdims=True)
     assert np.all((d_new @ d_old.T).max(axis=1) > 1.0 - 1e-12)
+
+
+def test_a_box_standing_on_the_floor_shadows_the_floor_right_up_to_its_base():
+    """Closed casters' volumes start at the caster itself (the dark cap, no offset): a floor
+    point 1e-4 beside the box's shadowed base edge is inside the volume; with the old offset
+    of 1e-3 of the scene diagonal (0.03 here) it was outside, a lit sliver along the base."""
+    box = trimesh.creation.box(extents=(1.0, 1.0, 1.0))
+    vertices = np.asarray(box.vertices) + [0.0, 0.5 + 1e-3, 0.0]     # standing on y = 0
+    light = light_homogeneous("point", (3.0, 4.0, 0.5), None)
+    volume = shadow_volume(vertices, box.faces, light, offset=0.03)
+    assert volume.method == "silhouette"
+    solid = _closed(volume)
+    assert solid.is_watertight
+    beside = [[-0.5 - 1e-4, 1e-4, 0.0], [-0.5 - 1e-3, 1e-4, 0.3]]  # just past the base edge
+    lit = [[0.5 + 1e-3, 1e-4, 0.0]]                                 # the light's side
+    assert solid.contains(beside).all() and not solid.contains(lit).any()

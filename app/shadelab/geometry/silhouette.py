@@ -20,11 +20,14 @@ Casters
   This is always correct (the union of the per-triangle volumes is the shadow) but costs
   more fill than a silhouette volume. Nothing is refused and nothing is "repaired".
 
-Every volume starts beyond its caster along the light's rays (closed casters: ``offset`` world
-units; per-triangle volumes: far enough to be ``offset`` off the triangle's plane, up to
-``GRAZING_LIMIT`` offsets at grazing light), so the caster's own surface lies strictly outside
-its volume (no self-shadowing acne from depth ties) while the shadow's outline, made of rays
-through the silhouette, stays exactly where it is.
+Per-triangle volumes start beyond their triangle along the light's rays (far enough to be
+``offset`` off the triangle's plane, up to ``GRAZING_LIMIT`` offsets at grazing light), so the
+lit triangle lies strictly outside its own volume (no self-shadowing acne from depth ties)
+while the shadow's outline, made of rays through its edges, stays where it is. Closed casters
+need no offset: their lit faces are off the volume's boundary, and the dark faces on it get no
+light whatever S_i is (N.L <= 0, or below the terminator fade's threshold on smooth meshes).
+An offset there would open a lit gap where the caster touches a receiver (a box standing on a
+floor, a sphere's contact point).
 """
 
 from __future__ import annotations
@@ -145,7 +148,10 @@ def shadow_volume(vertices: np.ndarray, faces: np.ndarray, light: np.ndarray,
         n = len(v)
         dark = f[~lit]
         volume_faces = np.concatenate([_sides(edges, n), dark[:, ::-1], dark + n])
-        shift = offset * away_from_light(v, light)  # along the light's rays: stays closed
+        # No offset: the lit faces are off the volume's boundary (the dark cap), and the dark
+        # faces on it get no light whatever S_i is (N.L <= t: the terminator fade). Moving the
+        # volume would open a lit gap where the caster touches a receiver (a box on a floor).
+        shift = np.zeros_like(v)
         return ShadowVolume(_homogeneous(v, light, shift), volume_faces, edges, "silhouette")
     # Per-triangle volumes: an unshared triangle soup, each turned to face the light.
     tri = vertices[faces]

@@ -23,7 +23,7 @@ from shadelab.gl.programs import load_program, set_uniform
 from shadelab.scene.camera import gl_matrix
 from shadelab.scene.model import Light, Scene
 
-OFFSET_FRACTION = 1e-3  # volumes start this share of the scene's diagonal beyond the caster
+OFFSET_FRACTION = 1e-3  # open casters' volumes start this share of the scene's diagonal away
 VOLUME_COLOR = (0.25, 0.45, 1.0, 0.18)  # translucent volumes (linear RGB, alpha)
 SILHOUETTE_COLOR = (1.0, 0.85, 0.1, 1.0)
 HEAT_LEVELS = 8  # stencil counts 1..8 get their own color; above 8 shows as 8
