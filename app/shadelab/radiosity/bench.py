@@ -4,8 +4,10 @@ to a first lit image with progressive refinement.
 
 Error metric (``image_error``): relative L1, sum |img - ref| / sum |ref|, over the pixels
 that do not see an emitter or touch one (a one-pixel ring, diagonals included). Both images
-are box-filtered pixels: the path tracer's jittered samples, radiosity's 4 x 4 sub-pixel
-centres. The light's
+are box-filtered pixels: the path tracer's jittered samples, radiosity's 16 x 16 sub-pixel
+centres (4 x 4 left a coverage error at every silhouette and room edge that dominated the
+metric: Cornell 32 x 32, 2400 uniform patches against 16k spp, 2.1 % at 4 x 4, 1.7 % at
+8 x 8, 1.2 % at 16 x 16 -- the pixels' geometry, not the illumination). The light's
 own pixels hold Le in both by definition; at its edges a 0.04-pixel difference in sampling
 swings those pixels (L = 20 against ~0.2 on the walls) more than all the rest of the image,
 so they would measure sampling of the light's outline, not illumination.
@@ -13,12 +15,21 @@ so they would measure sampling of the light's outline, not illumination.
 
 from __future__ import annotations
 
+import hashlib
+import math
+import os
 import time
+from pathlib import Path
 
 import numpy as np
 
 TARGET = 0.05  # relative error the timings aim for
-SUPERSAMPLE = 4  # radiosity sub-pixels per side for the comparison
+SUPERSAMPLE = 16  # radiosity sub-pixels per side for the comparison
+BUDGET_S = 2.0  # wall time for ``radiosity_error_in_2s`` (meshing + form factors + solve)
+ERROR_SIZE = (32, 32)  # pixels of the error-vs-time comparison (its 16k-spp reference's
+#                        own noise is ~0.6 % there; at 64 x 64 it would be ~1.2 %)
+REFERENCE_SPP = 8192  # per seed; two seeds averaged: 16k spp
+REFERENCE_SEEDS = (101, 202)
 
 
 def emitter_ring_mask(solution, size: tuple[int, int]) -> np.ndarray:
@@ -44,11 +55,11 @@ def image_error(image: np.ndarray, reference: np.ndarray, mask: np.ndarray) -> f
 
 def radiosity_image(scene, size, patches: int, solver: str = "gauss-seidel",
                     adaptive: bool = False,
-                    method: str = "raycast"):
+                    method: str = "raycast", meshing: str = "uniform"):
     """(solution, supersampled CPU image) of one solve."""
     from shadelab.radiosity.solution import solve_scene
 
-    solution = solve_scene(scene, patches, method, solver, adaptive=adaptive)
+    solution = solve_scene(scene, patches, method, solver, adaptive=adaptive, meshing=meshing)
     return solution, solution.image(size, supersample=SUPERSAMPLE)
 
 
@@ -68,6 +79,105 @@ def time_radiosity(scene, size, reference, counts, mask=None) -> dict:
     hit = next((r for r in rows if r["error"] <= TARGET), None)
     return {"runs": rows, "seconds_to_target": hit["seconds"] if hit else None,
             "patches_at_target": hit["patches"] if hit else None}, mask
+
+
+def cache_dir() -> Path:
+    """The user cache directory of shadelab ($SHADELAB_CACHE, else $XDG_CACHE_HOME/shadelab,
+    else ~/.cache/shadelab)."""
+    if os.environ.get("SHADELAB_CACHE"):
+        return Path(os.environ["SHADELAB_CACHE"])
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "shadelab"
+
+
+def converged_reference(scene, size, spp: int = REFERENCE_SPP,
+                        seeds=REFERENCE_SEEDS) -> tuple[np.ndarray, list[np.ndarray], dict]:
+    """(mean image, one image per seed, info) of independent path-traced renders, cached on
+    disk under :func:`cache_dir` by a hash of the scene, size, spp and seed (minutes to make
+    once: 32 x 32 x 8192 spp is ~50 s a seed on one core). The seeds' images give the
+    reference's own noise: ``info["noise_floor"]`` is set by :func:`reference_noise`."""
+    from shadelab.raytrace.pathtrace import render_pathtraced
+
+    key = hashlib.sha1(repr(scene).encode()).hexdigest()[:16]
+    folder = cache_dir() / "radiosity-reference"
+    images, made_s, cached = [], 0.0, True
+    for seed in seeds:
+        path = folder / f"{key}-{size[0]}x{size[1]}-{spp}spp-seed{seed}.npy"
+        if path.exists():
+            images.append(np.load(path))
+            continue
+        cached = False
+        start = time.perf_counter()
+        image = render_pathtraced(scene, size, spp, seed=seed)
+        made_s += time.perf_counter() - start
+        folder.mkdir(parents=True, exist_ok=True)
+        np.save(path, image)
+        images.append(image)
+    mean = np.mean([np.asarray(i, np.float64) for i in images], axis=0)
+    return mean, images, {"spp": spp * len(seeds), "seeds": list(seeds), "size": list(size),
+                          "cached": cached, "render_s": made_s, "folder": str(folder)}
+
+
+def reference_noise(images: list[np.ndarray], mask: np.ndarray) -> float:
+    """Expected relative L1 of the mean of ``images`` against the truth: the seeds' mutual
+    error divided by sqrt(2) per seed pair and by sqrt(k) for the k-image mean (for two
+    images: half their mutual error)."""
+    if len(images) < 2:
+        return float("nan")
+    pair = image_error(images[0], images[1], mask)  # ~ sqrt(2) * one image's noise
+    return float(pair / math.sqrt(2.0) / math.sqrt(len(images)))
+
+
+def error_vs_time(scene, size, reference, mask, counts, meshing: str,
+                  budget_s: float | None = None) -> list[dict]:
+    """Rows (patches, seconds, error) of uniform-solver runs at increasing patch counts:
+    ``seconds`` is meshing + ray-cast form factors + Gauss-Seidel (the image is not timed);
+    stops after the first run over ``budget_s`` past the budget (to show the trend)."""
+    from shadelab.radiosity.solution import solve_scene
+
+    rows = []
+    for count in counts:
+        start = time.perf_counter()
+        solution = solve_scene(scene, count, "raycast", "gauss-seidel", adaptive=False,
+                               meshing=meshing)
+        seconds = time.perf_counter() - start
+        image = solution.image(size, supersample=SUPERSAMPLE)
+        rows.append({"target": int(count), "patches": len(solution.patches),
+                     "seconds": seconds, "error": image_error(image, reference, mask)})
+        if budget_s is not None and seconds > 1.5 * budget_s:
+            break
+    return rows
+
+
+def best_within(rows: list[dict], budget_s: float) -> dict | None:
+    """The lowest-error row whose seconds are within the budget (None: none is)."""
+    inside = [r for r in rows if r["seconds"] <= budget_s]
+    return min(inside, key=lambda r: r["error"]) if inside else None
+
+
+def error_in_budget(scene, quick: bool) -> dict:
+    """``radiosity_error_in_2s`` and the error-vs-time series for uniform and discontinuity
+    meshing against the cached 16k-spp reference (:data:`ERROR_SIZE` pixels)."""
+    size = ERROR_SIZE
+    reference, images, info = converged_reference(scene, size)
+    counts = (300, 600, 800, 1000, 1100) if quick else \
+        (200, 400, 600, 800, 900, 1000, 1100, 1200, 1600)
+    series, mask = {}, None
+    for meshing in ("uniform", "discontinuity"):
+        from shadelab.radiosity.solution import solve_scene
+
+        solve_scene(scene, 20, "raycast", "gauss-seidel", adaptive=False, meshing=meshing)
+        if mask is None:
+            mask = emitter_ring_mask(solve_scene(scene, 100, adaptive=False), size)
+        series[meshing] = error_vs_time(scene, size, reference, mask, counts, meshing,
+                                        budget_s=BUDGET_S)
+    info["noise_floor"] = reference_noise(images, mask)
+    best = {m: best_within(rows, BUDGET_S) for m, rows in series.items()}
+    errors = [b["error"] for b in best.values() if b is not None]
+    return {"radiosity_error_in_2s": min(errors) if errors else None,
+            "best_in_2s": best, "goal": 0.015, "budget_s": BUDGET_S, "size": list(size),
+            "supersample": SUPERSAMPLE, "reference": info, "error_vs_time": series,
+            "timed": "meshing + ray-cast form factors + Gauss-Seidel, single process"}
 
 
 def time_pathtracer(scene, size, reference, mask, spps, seed: int = 7) -> dict:
@@ -174,7 +284,8 @@ def run(quick: bool) -> dict:
     return {
         "scene": "cornell", "size": list(size), "target_relative_error": TARGET,
         "metric": "relative L1 over pixels away from the light (1-pixel ring excluded); "
-                  "radiosity 4x4 supersampled, ray-cast form factors, Gauss-Seidel, uniform "
+                  f"radiosity {SUPERSAMPLE}x{SUPERSAMPLE} supersampled, ray-cast form factors, "
+                  "Gauss-Seidel, uniform "
                   "patches; both single-threaded",
         "reference": {"spp": ref_spp, "seconds": ref_seconds, "seed": 1001},
         "radiosity": radiosity, "pathtracer": pathtracer,
@@ -182,4 +293,11 @@ def run(quick: bool) -> dict:
         "projected_512": projected,
         "first_lit_image_progressive": first, "first_lit_image_goal_s": 0.5,
         "scaling_vs_patches": radiosity_scaling(scene, quick),
+        **_in_budget(scene, quick),
     }
+
+
+def _in_budget(scene, quick: bool) -> dict:
+    figure = error_in_budget(scene, quick)
+    return {"radiosity_error_in_2s": figure["radiosity_error_in_2s"],
+            "radiosity_error_vs_time": figure}

@@ -210,12 +210,12 @@ def uniform_patches(scene: Scene, count: int) -> PatchSet:
 def assemble(scene: Scene, surfaces: list[Surface], leaves: list[tuple]) -> PatchSet:
     """Build the patch arrays from quad leaves plus every mesh surface's triangles."""
     polygons, surface_of, rects, tris = [], [], [], []
-    for index, x0, y0, x1, y1 in leaves:
-        s = surfaces[index]
-        polygons.append(s.point(np.array([x0, x1, x1, x0]), np.array([y0, y0, y1, y1])))
-        surface_of.append(index)
-        rects.append((x0, y0, x1, y1))
-        tris.append((-1, -1, -1))
+    if len(leaves):
+        table = np.asarray(leaves, np.int64).reshape(-1, 5)
+        polygons = list(leaf_corners(surfaces, table))
+        surface_of = list(table[:, 0])
+        rects = [tuple(r) for r in table[:, 1:]]
+        tris = [(-1, -1, -1)] * len(table)
     for index, s in enumerate(surfaces):
         if s.kind != "mesh":
             continue
@@ -242,6 +242,17 @@ def assemble(scene: Scene, surfaces: list[Surface], leaves: list[tuple]) -> Patc
                        np.asarray(tris, np.int64).reshape(-1, 3)[keep])
     patches.info["patches"] = len(patches)
     return patches
+
+
+def leaf_corners(surfaces: list[Surface], table: np.ndarray) -> np.ndarray:
+    """(L, 4, 3) world corners of quadtree leaves, rows (surface, x0, y0, x1, y1)."""
+    out = np.zeros((len(table), 4, 3))
+    for index in np.unique(table[:, 0]):
+        rows = np.flatnonzero(table[:, 0] == index)
+        x0, y0, x1, y1 = (table[rows, k + 1] for k in range(4))
+        out[rows] = surfaces[int(index)].point(np.stack([x0, x1, x1, x0], axis=1),
+                                               np.stack([y0, y0, y1, y1], axis=1))
+    return out
 
 
 def _corner_weights(polygons: np.ndarray) -> np.ndarray:

@@ -121,6 +121,25 @@ def _rho_names(scene: Scene, patches: PatchSet) -> str:
 
 
 # ---------------------------------------------------------------------- meshing
+MESHINGS = ("uniform", "discontinuity")
+
+
+def check_meshing(meshing: str) -> None:
+    if meshing not in MESHINGS:
+        raise ShadeLabError(f"meshing {meshing!r}: expected one of {', '.join(MESHINGS)}")
+
+
+def base_patches(scene: Scene, count: int, meshing: str = "uniform") -> PatchSet:
+    """The first mesh: a regular grid, or one refined along contact lines and shadow
+    boundaries (:func:`shadelab.radiosity.meshing.discontinuity_patches`)."""
+    check_meshing(meshing)
+    if meshing == "discontinuity":
+        from shadelab.radiosity.meshing import discontinuity_patches
+
+        return discontinuity_patches(scene, count)
+    return uniform_patches(scene, count)
+
+
 def mesh_scene(scene: Scene, count: int, method: str = "raycast", adaptive: bool = True,
                resolution: int = 128, hemicube=None) -> PatchSet:
     """Patches for the scene: uniform, or refined where the radiosity changes fast.
@@ -202,7 +221,8 @@ def _settings(scene: Scene, patches, form_factors, solver):
 def iter_radiosity(scene: Scene, size: tuple[int, int] | None = None, patches: int | None = None,
                    form_factors: str | None = None, solver: str | None = None,
                    adaptive: bool = True, resolution: int | None = None,
-                   image_every: float = 0.25, hemicube=None) -> Iterator[Progress]:
+                   image_every: float = 0.25, hemicube=None,
+                   meshing: str = "uniform") -> Iterator[Progress]:
     """Radiosity as a progressive job: yields :class:`Progress` after each chunk of work.
 
     With ``adaptive`` the job solves a coarse uniform mesh first (``REFINE_SHARE`` of the
@@ -215,8 +235,11 @@ def iter_radiosity(scene: Scene, size: tuple[int, int] | None = None, patches: i
     ``solution`` (a :class:`RadiositySolution`). Close the generator to cancel.
     ``hemicube``: the GPU backend, required when the method is "hemicube"
     (``shadelab.render.hemicube.Hemicube``; see :class:`FormFactors`).
+    ``meshing``: the first mesh, "uniform" (a regular grid) or "discontinuity" (refined along
+    contact lines and shadow boundaries, hidden cells dropped: :mod:`.meshing`).
     """
     count, method, solver = _settings(scene, patches, form_factors, solver)
+    check_meshing(meshing)
     check_backend(method, hemicube)
     resolution = resolution or scene.radiosity.hemicube_resolution
     precheck(scene, count, method)
@@ -224,7 +247,7 @@ def iter_radiosity(scene: Scene, size: tuple[int, int] | None = None, patches: i
     stats = {"form_factors": method, "solver": solver, "target_patches": count}
     yield Progress(None, 0.0, "meshing", dict(stats))
     refine = adaptive and count >= 8
-    mesh = uniform_patches(scene, max(1, int(count * REFINE_SHARE)) if refine else count)
+    mesh = base_patches(scene, max(1, int(count * REFINE_SHARE)) if refine else count, meshing)
     stages = REFINE_ROUNDS + 1 if refine else 1
     for stage in range(stages):
         stats.update(stage=f"{stage + 1}/{stages}", patches=len(mesh),
@@ -334,11 +357,13 @@ def _fraction(step: Step, scene: Scene) -> float:
 
 def solve_scene(scene: Scene, patches: int | None = None, form_factors: str | None = None,
                 solver: str | None = None, adaptive: bool = True,
-                resolution: int | None = None, hemicube=None) -> RadiositySolution:
+                resolution: int | None = None, hemicube=None,
+                meshing: str = "uniform") -> RadiositySolution:
     """Mesh, compute form factors and solve; returns the solution (no images).
-    ``hemicube``: the GPU backend for hemicube form factors (see :func:`iter_radiosity`)."""
+    ``hemicube``: the GPU backend for hemicube form factors, ``meshing`` the first mesh
+    (see :func:`iter_radiosity`)."""
     job = iter_radiosity(scene, None, patches, form_factors, solver, adaptive, resolution,
-                         hemicube=hemicube)
+                         hemicube=hemicube, meshing=meshing)
     *_, last = job
     return last.stats["solution"]
 

@@ -18,6 +18,7 @@ from shadelab.studies.result import StudyResult, study_clock
 COLUMNS = ["series", "label", "patches", "form_factors", "resolution", "solver", "time_ms",
            "mae", "rmse", "relmse", "flip"]
 CONVERGENCE_COLUMNS = ["solver", "iteration", "time_ms", "residual"]
+MESHING_COLUMNS = ["meshing", "target", "patches", "time_ms", "l1"]
 PRESET = "cornell"
 
 
@@ -55,6 +56,37 @@ def convergence(solution, solver: str) -> list[list]:
         if np.isfinite(value) and value > 0:
             rows.append([solver, it, t * 1000.0, value])
     return rows
+
+
+def meshing_table(scene: Scene, quick: bool = False) -> StudyResult:
+    """Error against wall time, uniform against discontinuity meshing, both against a
+    converged path-traced reference (relative L1 away from the light, the bench's metric:
+    :func:`shadelab.radiosity.bench.error_in_budget` gives the same series at 32 x 32 and
+    16k spp; the quick table uses 16 x 16 and 2 x 512 spp, cached on disk)."""
+    from shadelab.radiosity import bench
+    from shadelab.radiosity.solution import solve_scene
+
+    size, spp, counts = ((16, 16), 512, (100, 300)) if quick else \
+        (bench.ERROR_SIZE, bench.REFERENCE_SPP, (200, 400, 600, 800, 1000, 1200))
+    reference, images, _ = bench.converged_reference(scene, size, spp)
+    mask = bench.emitter_ring_mask(solve_scene(scene, 100, adaptive=False), size)
+    rows = []
+    for meshing in ("uniform", "discontinuity"):
+        solve_scene(scene, 20, adaptive=False, meshing=meshing)  # warm-up
+        for r in bench.error_vs_time(scene, size, reference, mask, counts, meshing):
+            rows.append([meshing, r["target"], r["patches"], r["seconds"] * 1000.0,
+                         r["error"]])
+    floor = bench.reference_noise(images, mask)
+    return StudyResult(
+        name="radiosity-meshing",
+        title=f"Radiosity: error vs time by meshing (against {2 * spp} spp path tracing)",
+        columns=list(MESHING_COLUMNS), rows=rows, x="time_ms", y="l1", group="meshing",
+        label="patches",
+        notes=[f"relative L1 away from the light, {size[0]}x{size[1]} pixels, radiosity "
+               f"{bench.SUPERSAMPLE}x{bench.SUPERSAMPLE} sub-pixels; reference's own noise "
+               f"~{floor:.2%}",
+               "time: wall seconds of meshing + ray-cast form factors + Gauss-Seidel",
+               "discontinuity: hidden cells dropped, penumbra cells split (radiosity.meshing)"])
 
 
 def run_radiosity(quick: bool = False) -> StudyResult:
@@ -106,7 +138,7 @@ def run_radiosity(quick: bool = False) -> StudyResult:
                "refinement computes its rows of F as it shoots",
                "'analytic' form factors ignore occlusion (the blocks): a biased floor",
                "time: process CPU time (shadelab.studies.result.study_clock)"],
-        extra={"convergence": convergence_table})
+        extra={"convergence": convergence_table, "meshing": meshing_table(scene, quick)})
 
 
 def auto_radiosity(scene: Scene, size: tuple[int, int], budget: float,
