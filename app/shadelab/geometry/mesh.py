@@ -12,11 +12,11 @@ from functools import cached_property, lru_cache
 from pathlib import Path
 
 import numpy as np
-import trimesh
-from trimesh.transformations import euler_matrix
+from pyrr import matrix33
 
 from shadelab import limits
 from shadelab.errors import ShadeLabError
+from shadelab.geometry import cache
 from shadelab.geometry.normals import corner_normals, face_areas, face_normals, terminator_threshold
 from shadelab.paths import file_problem
 from shadelab.progress import busy, steps
@@ -104,9 +104,15 @@ def _cached_mesh(key: tuple, shape: str, index: int):
     vertices = vertices @ matrix[:3, :3].T + matrix[:3, 3]
     if np.linalg.det(matrix[:3, :3]) < 0.0:  # a mirroring scale flips the winding back
         faces = faces[:, ::-1].copy()
-    with busy(f"objects.{index}: {len(faces)} triangles' normals"):
-        fn = face_normals(vertices, faces)
-        cn = corner_normals(vertices, faces, obj.normals, obj.crease_angle)
+    fn = face_normals(vertices, faces)
+    name = cache.key("normals", vertices, faces, obj.normals, obj.crease_angle)
+    hit = cache.load(name)
+    if hit is not None and hit.get("corner_normals", np.empty(0)).shape == (len(faces), 3, 3):
+        cn = hit["corner_normals"]
+    else:
+        with busy(f"objects.{index}: {len(faces)} triangles' normals"):
+            cn = corner_normals(vertices, faces, obj.normals, obj.crease_angle)
+        cache.store(name, {"corner_normals": cn})
     for array in (vertices, faces, uvs, fn, cn):
         array.setflags(write=False)
     return vertices, faces, uvs, fn, cn
@@ -125,8 +131,10 @@ def _object_from_key(key: tuple) -> Object:
 def world_from_object(obj: Object) -> np.ndarray:
     """4x4 (column-vector) transform: scale, then rotate X, Y, Z (degrees), then translate."""
     rx, ry, rz = (math.radians(a) for a in obj.rotate)
-    matrix = euler_matrix(rx, ry, rz, "sxyz")
-    matrix[:3, :3] = matrix[:3, :3] @ np.diag(obj.scale)
+    rotation = (matrix33.create_from_z_rotation(rz) @ matrix33.create_from_y_rotation(ry)
+                @ matrix33.create_from_x_rotation(rx))   # static x, then y, then z
+    matrix = np.eye(4)
+    matrix[:3, :3] = rotation @ np.diag(obj.scale)
     matrix[:3, 3] = obj.translate
     return matrix
 
@@ -154,6 +162,37 @@ def _local_mesh(obj: Object, base_dir: str, index: int):
         h = obj.size / 2.0
         corners = np.array([[-h, 0, h], [h, 0, h], [h, 0, -h], [-h, 0, -h]])
         return grid(corners, obj.segments)
+    if shape == "mesh":
+        mesh = load_mesh_file(obj.path, base_dir, f"objects.{index}.path")
+        vertices = np.asarray(mesh.vertices, dtype=np.float64)
+        faces = np.asarray(mesh.faces, dtype=np.int64)
+        return vertices, faces, _projected_uvs(vertices, shape)
+    name = cache.key("primitive", shape, obj.radius, obj.minor_radius, obj.height,
+                     tuple(obj.extents), obj.subdivisions, obj.sections)
+    hit = cache.load(name)
+    if _sound(hit):
+        vertices, faces = hit["vertices"], hit["faces"]
+    else:
+        vertices, faces = _primitive(obj, index)
+        cache.store(name, {"vertices": vertices, "faces": faces})
+    return vertices, faces, _projected_uvs(vertices, shape)
+
+
+def _sound(hit: dict | None) -> bool:
+    """A cached primitive that is what it says: (V, 3) float64, (F, 3) int64 in range."""
+    if hit is None or not {"vertices", "faces"} <= hit.keys():
+        return False
+    v, f = hit["vertices"], hit["faces"]
+    return (v.dtype == np.float64 and v.ndim == 2 and v.shape[1] == 3 and f.dtype == np.int64
+            and f.ndim == 2 and f.shape[1] == 3 and len(f) > 0
+            and 0 <= int(f.min()) and int(f.max()) < len(v) and bool(np.isfinite(v).all()))
+
+
+def _primitive(obj: Object, index: int) -> tuple[np.ndarray, np.ndarray]:
+    """A trimesh primitive's vertices (V, 3) float64 and faces (F, 3) int64."""
+    import trimesh
+
+    shape = obj.shape
     if shape == "sphere":
         mesh = trimesh.creation.icosphere(subdivisions=obj.subdivisions, radius=obj.radius)
     elif shape == "box":
@@ -170,13 +209,10 @@ def _local_mesh(obj: Object, base_dir: str, index: int):
         mesh = trimesh.creation.torus(major_radius=obj.radius, minor_radius=obj.minor_radius,
                                       major_sections=obj.sections,
                                       minor_sections=max(obj.sections // 2, 3))
-    elif shape == "mesh":
-        mesh = load_mesh_file(obj.path, base_dir, f"objects.{index}.path")
     else:
         raise ShadeLabError(f"objects.{index}.shape: unknown shape {shape!r}")
-    vertices = np.asarray(mesh.vertices, dtype=np.float64)
-    faces = np.asarray(mesh.faces, dtype=np.int64)
-    return vertices, faces, _projected_uvs(vertices, shape)
+    return (np.asarray(mesh.vertices, dtype=np.float64),
+            np.asarray(mesh.faces, dtype=np.int64))
 
 
 def _projected_uvs(vertices: np.ndarray, shape: str) -> np.ndarray:
@@ -208,7 +244,7 @@ def check_vertices(vertices: np.ndarray, where: str) -> None:
                             f"numbers within +-{LENGTH_MAX:g}")
 
 
-def load_mesh_file(path: str, base_dir: str, key: str) -> trimesh.Trimesh:
+def load_mesh_file(path: str, base_dir: str, key: str):
     """Load a mesh file, refusing what no renderer can use, with a one-line reason."""
     full = Path(path) if Path(path).is_absolute() else Path(base_dir) / path
     problem = file_problem(full)
@@ -220,6 +256,8 @@ def load_mesh_file(path: str, base_dir: str, key: str) -> trimesh.Trimesh:
     size = full.stat().st_size
     limits.check(f"{key}: '{full.name}'", size, limits.MAX_MESH_FILE_BYTES, "bytes",
                  memory_bytes=8.0 * size)  # trimesh's arrays and its text parse
+    import trimesh
+
     try:
         with busy(f"{key}: reading '{full.name}'"):
             mesh = trimesh.load(str(full), force="mesh", process=False)

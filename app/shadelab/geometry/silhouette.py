@@ -35,7 +35,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import trimesh
+
+from shadelab.geometry import cache
 
 GRAZING_LIMIT = 20.0  # per-triangle caps move at most this many offsets along the rays
 
@@ -95,17 +96,51 @@ def facing_light(vertices: np.ndarray, faces: np.ndarray, light: np.ndarray) -> 
     return np.einsum("ij,ij->i", normal, to_light) > 0.0
 
 
-def closed_caster(vertices: np.ndarray, faces: np.ndarray) -> trimesh.Trimesh | None:
+@dataclass
+class ClosedMesh:
+    """A caster as a closed, consistently wound, outward-facing mesh (trimesh's merge) and
+    its face adjacency: what the silhouette needs, cached on disk (:mod:`.cache`)."""
+
+    vertices: np.ndarray              # (V, 3) float64, merged
+    faces: np.ndarray                 # (F, 3) int64, outward
+    face_adjacency: np.ndarray        # (A, 2) int64 pairs of faces sharing an edge
+    face_adjacency_edges: np.ndarray  # (A, 2) int64 the shared edge's vertices
+
+
+def closed_caster(vertices: np.ndarray, faces: np.ndarray) -> ClosedMesh | None:
     """The caster as a closed, consistently wound, outward-facing mesh, or None."""
+    vertices = np.asarray(vertices, dtype=np.float64)
+    faces = np.asarray(faces, dtype=np.int64)
+    name = cache.key("closed", vertices, faces)
+    hit = cache.load(name)
+    if hit is not None and "open" in hit:
+        return None
+    fields = ("vertices", "faces", "face_adjacency", "face_adjacency_edges")
+    if hit is not None and set(fields) <= hit.keys():
+        closed = ClosedMesh(*(hit[k] for k in fields))
+        if len(closed.faces) and int(closed.faces.max()) < len(closed.vertices):
+            return closed
+    closed = _closed_with_trimesh(vertices, faces)
+    cache.store(name, {"open": np.ones(1)} if closed is None
+                else {k: getattr(closed, k) for k in fields})
+    return closed
+
+
+def _closed_with_trimesh(vertices: np.ndarray, faces: np.ndarray) -> ClosedMesh | None:
+    import trimesh
+
     mesh = trimesh.Trimesh(vertices, faces, process=True)
     if len(mesh.faces) == 0 or not (mesh.is_watertight and mesh.is_winding_consistent):
         return None
     if mesh.volume < 0.0:  # wound inside out: same surface, turned
         mesh.invert()
-    return mesh
+    return ClosedMesh(np.asarray(mesh.vertices, dtype=np.float64),
+                      np.asarray(mesh.faces, dtype=np.int64),
+                      np.asarray(mesh.face_adjacency, dtype=np.int64),
+                      np.asarray(mesh.face_adjacency_edges, dtype=np.int64))
 
 
-def silhouette_edges(mesh: trimesh.Trimesh, lit: np.ndarray) -> np.ndarray:
+def silhouette_edges(mesh: ClosedMesh, lit: np.ndarray) -> np.ndarray:
     """(E, 2) edges between a light-facing and a dark face, wound as in the lit face."""
     pairs = mesh.face_adjacency
     edges = mesh.face_adjacency_edges

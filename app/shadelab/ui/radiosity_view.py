@@ -139,6 +139,9 @@ class RadiosityView:
 _views: dict[int, RadiosityView] = {}
 
 
+FIRST_FRAMES = 2   # frames the viewer draws before this window builds its patches
+
+
 def view_of(state) -> RadiosityView:
     return _views.setdefault(id(state), RadiosityView())
 
@@ -220,6 +223,9 @@ def draw_panel(state) -> bool:
 
     if state.gl is None:
         imgui.text("(no GL context yet)")
+        return False
+    if state.frame < FIRST_FRAMES:   # the scene's first frame comes first (about a second)
+        imgui.text("building the patches ...")
         return False
     view = ensure(state)
     if view.error:
