@@ -24,6 +24,15 @@ def register_includes(ctx: moderngl.Context) -> None:
         ctx.includes[path.stem] = (header() if header else "") + text
 
 
+def stock_include(ctx: moderngl.Context, name: str) -> bool:
+    """Whether the context's include ``name`` is ShadeLab's own text (not a replacement, as
+    :func:`shadelab.testing.render_with_shaders` puts there for a student's chunk)."""
+    path = shaders_dir() / "include" / f"{name}.glsl"
+    header = GENERATED_HEADERS.get(name)
+    stock = (header() if header else "") + path.read_text(encoding="utf-8")
+    return ctx.includes.get(name) == stock
+
+
 def with_defines(source: str, defines: dict[str, object] | None) -> str:
     """Insert ``#define NAME VALUE`` lines right after the ``#version`` line."""
     if not defines:
@@ -50,9 +59,9 @@ def load_program(ctx: moderngl.Context, name: str,
 
 def set_uniform(program: moderngl.Program, name: str, value) -> None:
     """Set a uniform if the compiler kept it (unused uniforms are optimized away)."""
-    if name not in program:
+    uniform = program.get(name, None)  # a dict look-up; ``name in program`` scans every member
+    if uniform is None:
         return
-    uniform = program[name]
     if isinstance(value, (bytes, bytearray)):
         uniform.write(value)
     else:
@@ -61,8 +70,46 @@ def set_uniform(program: moderngl.Program, name: str, value) -> None:
 
 def set_uniform_array(program: moderngl.Program, name: str, array) -> None:
     """Write a uniform array; the compiler may have trimmed unused trailing elements."""
-    if name not in program:
+    uniform = program.get(name, None)
+    if uniform is None:
         return
-    uniform = program[name]
     count = max(uniform.array_length, 1)
     uniform.write(array[:count].tobytes())
+
+
+class UniformCache:
+    """A program's uniforms written only when their bytes change (one dict look-up and one
+    bytes comparison per uniform per frame; a GL write only for what moved).
+
+    Every write to a cached program must go through :meth:`write` or :meth:`write_array`;
+    :meth:`forget` drops the record after a write that bypassed it.
+    """
+
+    def __init__(self, program: moderngl.Program):
+        self.program = program
+        self._uniforms = {name: program[name] for name in program
+                          if isinstance(program[name], moderngl.Uniform)}
+        self._last: dict[str, bytes] = {}
+
+    def __contains__(self, name: str) -> bool:
+        return name in self._uniforms
+
+    def write(self, name: str, data: bytes) -> None:
+        """Write ``data`` (the uniform's packed bytes) unless it is what the GL holds."""
+        uniform = self._uniforms.get(name)
+        if uniform is None or self._last.get(name) == data:
+            return
+        uniform.write(data)
+        self._last[name] = data
+
+    def write_array(self, name: str, array) -> None:
+        """Write a uniform array trimmed to the elements the compiler kept."""
+        uniform = self._uniforms.get(name)
+        if uniform is not None:
+            self.write(name, array[:max(uniform.array_length, 1)].tobytes())
+
+    def forget(self, name: str | None = None) -> None:
+        if name is None:
+            self._last.clear()
+        else:
+            self._last.pop(name, None)

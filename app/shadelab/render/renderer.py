@@ -7,13 +7,20 @@ that changes a coefficient re-sets uniforms only; nothing is re-uploaded.
 from __future__ import annotations
 
 import math
+import struct
 from dataclasses import dataclass, replace
 
 import moderngl
 import numpy as np
 
 from shadelab.geometry.mesh import MeshData, geometry_key, object_mesh, scene_bounds
-from shadelab.gl.programs import load_program, set_uniform, set_uniform_array
+from shadelab.gl.programs import (
+    UniformCache,
+    load_program,
+    set_uniform,
+    set_uniform_array,
+    stock_include,
+)
 from shadelab.gl.target import RenderTarget
 from shadelab.gl.vertex import soup_vertex_array, triangle_soup
 from shadelab.render.painter import draw_painter
@@ -28,6 +35,10 @@ SHADING_PROGRAMS = ("flat", "gouraud", "phong")
 # Variants with texture-mapped Od and bump maps (a geometry shader adds the tangents); only
 # materials with a texture or a bump use them, so every other material keeps its output.
 TEXTURED_PROGRAMS = {name: f"{name}_tex" for name in SHADING_PROGRAMS}
+# The programs whose Od is the material's u_Od: compiled with PREMULTIPLIED (lighting.glsl), so
+# the per-material, per-light factors are folded here once instead of read per fragment.
+PREMULTIPLIED = {"PREMULTIPLIED": 1}
+MATERIAL_FLOATS = ("u_ka", "u_kd", "u_ks", "u_n")
 
 
 @dataclass
@@ -37,7 +48,7 @@ class GpuMesh:
     key: tuple
     mesh: MeshData
     vbo: moderngl.Buffer
-    vaos: dict[tuple, moderngl.VertexArray]  # keyed by (program name, light signature)
+    vaos: dict[tuple, moderngl.VertexArray]  # by (program name, (light signature, terminator))
     bounds: np.ndarray  # (2, 3) min and max corner, world space, computed once at upload
 
     def release(self) -> None:
@@ -53,6 +64,22 @@ class View:
     clip_from_world: np.ndarray
     eye: np.ndarray
     size: tuple[int, int]
+
+
+class ProgramUniforms:
+    """One shading program's uniform cache and the frame state its premultiplied material
+    uniforms are folded from (the lights as drawn, S_i included, Ia and the ambient switch)."""
+
+    def __init__(self, program: moderngl.Program):
+        self.cache = UniformCache(program)
+        self.premultiplied = "u_ambient" in self.cache or "u_light_diffuse" in self.cache
+        self.lights_key: object = None
+        self.ip_s = np.zeros((MAX_LIGHTS, 3))  # S_i Ip,i per light, padded
+        self.Ia = np.zeros(3)
+        self.Ia_values: tuple = ()
+        self.view: View | None = None  # the view whose matrix and eye the program holds
+        self.ambient_on = 1.0
+        self.materials: dict[tuple, list[tuple[str, bytes]]] = {}  # folded writes, per frame
 
 
 def make_view(scene: Scene, size: tuple[int, int], meshes: list[MeshData],
@@ -75,7 +102,15 @@ class Renderer:
     def __init__(self, ctx: moderngl.Context):
         self.ctx = ctx
         self._variants: dict[tuple, dict[str, moderngl.Program]] = {}
+        self._uniforms: dict[moderngl.Program, ProgramUniforms] = {}
+        self._light_arrays: dict[str, tuple[str, dict[str, np.ndarray]]] = {}
+        self._view_key: tuple | None = None
+        self._view: View | None = None  # the last view_for, while its key holds
+        self._matrix: tuple[View, bytes] | None = None  # the last view's matrix, packed
+        self._bounds: tuple | None = None  # (mesh ids, their union box, the meshes)
+        self._batches: dict[tuple, GpuMesh] = {}  # runs of meshes of one material, merged
         self.light_signature: tuple = ((), "phong")
+        self._variant_key: tuple = (self.light_signature, False)
         self.programs = self.programs_for_lights([], "phong")
         self.textures = TextureCache(ctx)
         self._gpu: dict[int, GpuMesh] = {}
@@ -98,30 +133,49 @@ class Renderer:
                 "LIGHT_ATTENUATIONS": f"{attenuations}u",
                 "SPECULAR_MODEL": SPECULAR_CODES[model]}
 
-    def programs_for_lights(self, lights: list[Light], specular: str) -> dict:
+    def programs_for_lights(self, lights: list[Light], specular: str,
+                            terminator: bool = False) -> dict:
         """Every shading program compiled for this light configuration (cached).
 
         Positions, colors and coefficients stay uniforms, so sliders never recompile; adding
         a light or changing a light's kind or attenuation mode compiles a new variant once.
         Passes that draw a subset of the lights (the shadow passes) switch the others off with
-        their shadow factor S_i = 0.
+        their shadow factor S_i = 0. ``terminator``: the variant of the shadow-volume lit pass,
+        which fades S_i by the mesh's u_terminator (lighting.glsl's TERMINATOR); every other
+        pass has none to fade and leaves the term out.
         """
         signature = self.light_signature_of(lights, specular)
-        if signature not in self._variants:
+        key = (signature, terminator)
+        if key not in self._variants:
             defines = self.light_defines(signature)
-            names = [*SHADING_PROGRAMS, *TEXTURED_PROGRAMS.values()]
-            self._variants[signature] = {name: load_program(self.ctx, name, defines)
-                                         for name in names}
-        return self._variants[signature]
+            if terminator:
+                defines["TERMINATOR"] = 1
+            variant = {name: load_program(self.ctx, name, defines)
+                       for name in TEXTURED_PROGRAMS.values()}
+            # ShadeLab's lighting chunk: the plain programs premultiplied; a replaced chunk (a
+            # student's) reads its own uniforms as written
+            fast = PREMULTIPLIED if stock_include(self.ctx, "lighting") else {}
+            variant.update({name: load_program(self.ctx, name, {**defines, **fast})
+                            for name in SHADING_PROGRAMS})
+            self._variants[key] = variant
+        return self._variants[key]
 
-    def use_lights(self, lights: list[Light], specular: str) -> None:
+    def uniforms(self, program: moderngl.Program) -> ProgramUniforms:
+        """The uniform cache of one of this renderer's programs (made on first use)."""
+        state = self._uniforms.get(program)
+        if state is None:
+            state = self._uniforms[program] = ProgramUniforms(program)
+        return state
+
+    def use_lights(self, lights: list[Light], specular: str, terminator: bool = False) -> None:
         """Make ``self.programs`` the variant for these lights (once per frame)."""
         self.light_signature = self.light_signature_of(lights, specular)
-        self.programs = self.programs_for_lights(lights, specular)
+        self._variant_key = (self.light_signature, terminator)
+        self.programs = self.programs_for_lights(lights, specular, terminator)
 
     def vao(self, gpu: GpuMesh, program_name: str) -> moderngl.VertexArray:
         """The object's VAO for a program of the current light variant (made lazily)."""
-        key = (program_name, self.light_signature)
+        key = (program_name, self._variant_key)
         vao = gpu.vaos.get(key)
         if vao is None:
             vao = soup_vertex_array(self.ctx, self.programs[program_name], gpu.vbo)
@@ -136,6 +190,7 @@ class Renderer:
             key = geometry_key(obj, scene.base_dir)
             gpu = self._gpu.get(index)
             if gpu is None or gpu.key != key:
+                self._release_batches()
                 if gpu is not None:
                     gpu.release()
                 gpu = self._upload(key, object_mesh(obj, index, scene.base_dir))
@@ -143,6 +198,7 @@ class Renderer:
             gpu.mesh.material = obj.material
             live.append(gpu)
         for index in [i for i in self._gpu if i >= len(scene.objects)]:
+            self._release_batches()
             self._gpu.pop(index).release()
         return live
 
@@ -165,20 +221,96 @@ class Renderer:
         material = scene.materials[name]
         program_name = self.program_for(shading, material)
         program = self.programs[program_name]
-        self.set_material_uniforms(program, material)
+        self.write_material(program, material)
         if program_name != shading:
             self.textures.bind(program, name, material, scene.base_dir)
         return program_name
 
     def set_frame_uniforms(self, program: moderngl.Program, scene: Scene, view: View,
-                           specular: str, lights: list[Light] | None = None) -> None:
+                           specular: str, lights: list[Light] | None = None,
+                           ambient_on: float = 1.0) -> None:
         """Camera, ambient, specular model and the lights (the scene's active ones unless
-        ``lights`` is given, as the shadow passes do one light at a time)."""
-        set_uniform(program, "u_clip_from_world", gl_matrix(view.clip_from_world))
-        set_uniform(program, "u_eye", tuple(view.eye))
-        set_uniform(program, "u_Ia", tuple(scene.Ia))
-        set_uniform(program, "u_specular_model", SPECULAR_CODES[specular])
-        write_light_uniforms(program, scene.active_lights() if lights is None else lights)
+        ``lights`` is given, as the shadow passes do one light at a time); ``ambient_on`` 0
+        leaves Le + Ia ka Od out (the shadow passes' added lights). Written only if changed."""
+        state = self.uniforms(program)
+        cache = state.cache
+        if state.view is not view:
+            cache.write("u_clip_from_world", self._view_matrix(view))
+            cache.write("u_eye", struct.pack("3f", *view.eye))
+            state.view = view
+        Ia = tuple(scene.Ia)
+        if Ia != state.Ia_values:
+            state.Ia_values, state.Ia = Ia, np.asarray(Ia, dtype=np.float64)
+            cache.write("u_Ia", struct.pack("3f", *Ia))
+        cache.write("u_specular_model", struct.pack("i", SPECULAR_CODES[specular]))
+        self.set_frame_lights(program, scene.active_lights() if lights is None else lights,
+                              ambient_on)
+
+    def set_frame_lights(self, program: moderngl.Program, lights: list[Light],
+                         ambient_on: float = 1.0) -> None:
+        """The ``u_light_*`` arrays and the ambient switch, through the program's cache; the
+        premultiplied material uniforms are folded from them at the next draw."""
+        state = self.uniforms(program)
+        key, arrays = self._lights_packed(lights)
+        frame = (key, state.Ia_values, ambient_on)
+        if frame == state.lights_key:
+            return  # what the cache wrote last time
+        for name, array in arrays.items():
+            state.cache.write_array(name, array)
+        state.cache.write("u_ambient_on", struct.pack("f", ambient_on))
+        state.lights_key = frame
+        state.ip_s = (arrays["u_light_Ip"].astype(np.float64)
+                      * arrays["u_light_S"].astype(np.float64)[:, None])
+        state.ambient_on = ambient_on
+        state.materials.clear()
+
+    def _lights_packed(self, lights: list[Light]) -> tuple[str, dict[str, np.ndarray]]:
+        """:func:`light_uniform_arrays` of ``lights``, kept while the lights' values stay."""
+        key = repr(lights)
+        packed = self._light_arrays.get(key)
+        if packed is None:
+            if len(self._light_arrays) > 64:
+                self._light_arrays.clear()
+            packed = self._light_arrays[key] = (key, light_uniform_arrays(lights))
+        return packed
+
+    def _view_matrix(self, view: View) -> bytes:
+        if self._matrix is None or self._matrix[0] is not view:
+            self._matrix = (view, gl_matrix(view.clip_from_world))
+        return self._matrix[1]
+
+    def view_for(self, scene: Scene, size: tuple[int, int], gpu_meshes: list[GpuMesh],
+                 infinite_far: bool) -> View:
+        """:func:`make_view`, kept while the camera, size, far plane and bounds stay."""
+        ids = tuple(map(id, gpu_meshes))
+        if self._bounds is None or self._bounds[0] != ids:
+            # the memo keeps the meshes alive, so their ids stay theirs
+            self._bounds = (ids, _union_bounds([g.bounds for g in gpu_meshes]), gpu_meshes)
+        bounds = self._bounds[1]
+        camera = scene.camera
+        key = (tuple(camera.eye), tuple(camera.target), tuple(camera.up), camera.fov_y,
+               camera.near, tuple(size), infinite_far,
+               None if bounds is None else bounds.tobytes())
+        if key != self._view_key or self._view is None:
+            self._view = make_view(scene, size, [g.mesh for g in gpu_meshes], infinite_far,
+                                   bounds)
+            self._view_key = key
+        return self._view
+
+    def write_material(self, program: moderngl.Program, material: Material) -> None:
+        """One material's uniforms through the program's cache: the raw coefficients where the
+        program reads them, the folded u_ambient, u_light_diffuse, u_light_specular where it is
+        PREMULTIPLIED (computed once per material and frame state)."""
+        state = self.uniforms(program)
+        values = (material.ka, material.kd, material.ks, material.n, *material.Od,
+                  *material.Os, *material.emission)
+        writes = state.materials.get(values)
+        if writes is None:
+            if len(state.materials) > 256:  # a slider sweeping a coefficient
+                state.materials.clear()
+            writes = state.materials[values] = _material_writes(state, values)
+        for name, data in writes:
+            state.cache.write(name, data)
 
     @staticmethod
     def set_material_uniforms(program: moderngl.Program, material: Material) -> None:
@@ -201,8 +333,7 @@ class Renderer:
         painter = settings.visibility == "painter"
         shadowed = settings.shadows == "volumes" and bool(lights) and not painter
         # Shadow volumes reach infinity (w = 0): the whole frame then uses an infinite far plane.
-        view = make_view(scene, target.size, [g.mesh for g in gpu_meshes], infinite_far=shadowed,
-                         bounds=_union_bounds([g.bounds for g in gpu_meshes]))
+        view = self.view_for(scene, target.size, gpu_meshes, shadowed)
         opaque = [g for g in gpu_meshes if not is_transparent(scene.materials[g.mesh.material])]
         clear = [g for g in gpu_meshes if is_transparent(scene.materials[g.mesh.material])]
         # --- PASS 1: clear color, depth and stencil
@@ -211,7 +342,6 @@ class Renderer:
             # --- PASS 2 (list priority): every triangle back to front, no depth test
             for variant in self.variants(shading):
                 self.set_frame_uniforms(variant, scene, view, specular)
-                set_uniform(variant, "u_ambient_on", 1.0)
             draw_painter(self, scene, gpu_meshes, shading, view)
             return view
         # --- PASS 2: opaque surfaces, ambient + every light in one pass (S_i = 1);
@@ -221,7 +351,6 @@ class Renderer:
             self.use_lights([], specular)  # programs with no light loop: ambient + Le only
         for variant in self.variants(shading):
             self.set_frame_uniforms(variant, scene, view, specular)
-            set_uniform(variant, "u_ambient_on", 1.0)
         self.draw_objects(scene, opaque, shading)
         if shadowed:
             self.use_lights(lights, specular)
@@ -237,7 +366,6 @@ class Renderer:
         if clear:
             for variant in self.variants(shading):
                 self.set_frame_uniforms(variant, scene, view, specular)
-                set_uniform(variant, "u_ambient_on", 1.0)
             draw_transparent(self, scene, clear, shading, view)
         # --- PASS 5: teaching overlays: stencil heat map, translucent volumes, silhouettes
         if shadowed and (settings.stencil_heatmap or settings.show_volumes
@@ -271,10 +399,10 @@ class Renderer:
                 self.ctx.blend_func = moderngl.ONE, moderngl.ONE
                 self.ctx.depth_func = "<="
                 shadows.lit_where_zero(ref)
-                self.use_lights([lit], specular)
+                self.use_lights([lit], specular, terminator=True)
                 for variant in self.variants(shading):
-                    self.set_frame_uniforms(variant, scene, view, specular, [lit])
-                    set_uniform(variant, "u_ambient_on", 0.0)
+                    self.set_frame_uniforms(variant, scene, view, specular, [lit],
+                                            ambient_on=0.0)
                 self.draw_objects(scene, opaque, shading, terminator=True)
                 for variant in self.variants(shading):   # this light's variant: fade off again
                     set_uniform(variant, "u_terminator", 0.0)
@@ -285,8 +413,7 @@ class Renderer:
         target.fbo.depth_mask = True
         target.fbo.use()
         for variant in self.variants(shading):
-            write_light_uniforms(variant, lights)
-            set_uniform(variant, "u_ambient_on", 1.0)
+            self.set_frame_lights(variant, lights, ambient_on=1.0)
 
     def _stencil_for_light(self, scene: Scene, target: RenderTarget, view: View, volumes,
                            method: str, light: Light) -> list[tuple[int, Light]]:
@@ -358,6 +485,11 @@ class Renderer:
         """Draw each mesh with its material; ``terminator`` (the shadow-volume lit pass) sets
         each smooth mesh's terminator threshold, which fades S_i where N.L nears it."""
         soften = terminator and shading != "flat"   # flat: N = Ng, nothing to join
+        if not terminator:  # no per-mesh uniform: one draw per run of one material
+            for run in _material_runs(gpu_meshes):
+                program_name = self.use_material(scene, run[0].mesh.material, shading)
+                self.vao(self._batch(run), program_name).render(moderngl.TRIANGLES)
+            return
         for gpu in gpu_meshes:
             program_name = self.use_material(scene, gpu.mesh.material, shading)
             if terminator:
@@ -365,7 +497,31 @@ class Renderer:
                             gpu.mesh.terminator if soften else 0.0)
             self.vao(gpu, program_name).render(moderngl.TRIANGLES)
 
+    def _batch(self, run: list[GpuMesh]) -> GpuMesh:
+        """Consecutive meshes of one material as one buffer (copied on the GPU once, kept
+        until the geometry changes): the same triangles in the same order, one draw."""
+        if len(run) == 1:
+            return run[0]
+        key = tuple(map(id, run))
+        batch = self._batches.get(key)
+        if batch is None:
+            vbo = self.ctx.buffer(reserve=sum(g.vbo.size for g in run))
+            offset = 0
+            for gpu in run:
+                self.ctx.copy_buffer(vbo, gpu.vbo, gpu.vbo.size, 0, offset)
+                offset += gpu.vbo.size
+            bounds = _union_bounds([g.bounds for g in run])
+            batch = self._batches[key] = GpuMesh(key, run[0].mesh, vbo, {}, bounds)
+        return batch
+
+    def _release_batches(self) -> None:
+        for batch in self._batches.values():
+            batch.release()
+        self._batches.clear()
+
     def release(self) -> None:
+        self._release_batches()
+        self._bounds = None
         for gpu in self._gpu.values():
             gpu.release()
         self._gpu.clear()
@@ -373,10 +529,23 @@ class Renderer:
             for program in variant.values():
                 program.release()
         self._variants.clear()
+        self._uniforms.clear()
+        self._view = self._view_key = self._matrix = None
         if self._shadows is not None:
             self._shadows.release()
             self._shadows = None
         self.textures.release()
+
+
+def _material_runs(gpu_meshes: list[GpuMesh]) -> list[list[GpuMesh]]:
+    """The meshes in order, cut where the material changes."""
+    runs: list[list[GpuMesh]] = []
+    for gpu in gpu_meshes:
+        if runs and runs[-1][0].mesh.material == gpu.mesh.material:
+            runs[-1].append(gpu)
+        else:
+            runs.append([gpu])
+    return runs
 
 
 def _union_bounds(boxes: list[np.ndarray]) -> np.ndarray | None:
@@ -392,22 +561,55 @@ def is_transparent(material: Material) -> bool:
     return material.kt > 0.0
 
 
-def write_light_uniforms(program: moderngl.Program, lights: list[Light],
-                         shadow: list[float] | None = None) -> None:
-    """Fill the ``u_light_*`` arrays of ``lighting.glsl`` (padded to MAX_LIGHTS) from
-    :func:`shadelab.shading.lights.pack_lights`, the packing the ray tracer's table uses."""
+def light_uniform_arrays(lights: list[Light],
+                         shadow: list[float] | None = None) -> dict[str, np.ndarray]:
+    """The ``u_light_*`` arrays of ``lighting.glsl`` (padded to MAX_LIGHTS) from
+    :func:`shadelab.shading.lights.pack_lights`, the packing the ray tracer's table uses, and
+    ``u_num_lights`` (int32, one element)."""
     count = min(len(lights), MAX_LIGHTS)
     packed = pack_lights(lights[:count])
     s = np.ones(MAX_LIGHTS, np.float32)
     if shadow is not None:
         s[:count] = shadow[:count]
-    set_uniform(program, "u_num_lights", count)
+    arrays = {"u_num_lights": np.array([count], np.int32)}
     for name, array in (("u_light_kind", packed.kind), ("u_light_attenuation", packed.attenuation),
                         ("u_light_position", packed.position),
                         ("u_light_direction", packed.direction), ("u_light_Ip", packed.Ip),
                         ("u_light_c", packed.c), ("u_light_spot", packed.spot)):
         padded = np.zeros((MAX_LIGHTS, *array.shape[1:]), array.dtype)
         padded[:count] = array
-        set_uniform_array(program, name, padded.astype(np.int32 if array.dtype.kind == "i"
-                                                       else np.float32))
-    set_uniform_array(program, "u_light_S", s)
+        arrays[name] = padded.astype(np.int32 if array.dtype.kind == "i" else np.float32)
+    arrays["u_light_S"] = s
+    return arrays
+
+
+def write_light_uniforms(program: moderngl.Program, lights: list[Light],
+                         shadow: list[float] | None = None) -> None:
+    """Fill the ``u_light_*`` arrays of ``lighting.glsl`` (see :func:`light_uniform_arrays`)."""
+    for name, array in light_uniform_arrays(lights, shadow).items():
+        set_uniform_array(program, name, array)
+
+
+def _material_writes(state: ProgramUniforms, values: tuple) -> list[tuple[str, bytes]]:
+    """(name, bytes) of a material's uniforms the program reads: ka, kd, ks, n, Od, Os, Le
+    as they are, and for a PREMULTIPLIED program the factors lighting.glsl folds:
+    u_ambient = on (Le + Ia ka Od), u_light_diffuse[i] = S_i Ip,i kd Od,
+    u_light_specular[i] = S_i Ip,i ks Os."""
+    ka, kd, ks, n = values[:4]
+    od, os_, emission = (np.asarray(values[k:k + 3], dtype=np.float64) for k in (4, 7, 10))
+    raw = {**dict(zip(MATERIAL_FLOATS, (struct.pack("f", v) for v in (ka, kd, ks, n)),
+                      strict=True)),
+           "u_Od": od.astype(np.float32).tobytes(), "u_Os": os_.astype(np.float32).tobytes(),
+           "u_emission": emission.astype(np.float32).tobytes()}
+    cache = state.cache
+    writes = [(name, data) for name, data in raw.items() if name in cache]
+    if state.premultiplied:
+        ambient = state.ambient_on * (emission + state.Ia * ka * od)
+        if "u_ambient" in cache:
+            writes.append(("u_ambient", ambient.astype(np.float32).tobytes()))
+        for name, factor in (("u_light_diffuse", kd * od), ("u_light_specular", ks * os_)):
+            uniform = cache.program.get(name, None)
+            if uniform is not None:
+                array = (state.ip_s * factor).astype(np.float32)
+                writes.append((name, array[:max(uniform.array_length, 1)].tobytes()))
+    return writes
