@@ -25,15 +25,21 @@ CACHE_ENV = "SHADELAB_CACHE_DIR"
 FORMAT = 1          # bump when what an entry holds changes
 
 
-def cache_dir() -> Path | None:
-    """The folder of the mesh cache, or None when it is turned off."""
+def cache_root() -> Path | None:
+    """ShadeLab's cache folder (meshes, the benches' references), or None when turned off."""
     chosen = os.environ.get(CACHE_ENV, "")
     if chosen.strip().lower() == "off":
         return None
     if chosen:
-        return Path(chosen) / "meshes"
+        return Path(chosen)
     base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "shadelab" / "meshes"
+    return Path(base) / "shadelab"
+
+
+def cache_dir() -> Path | None:
+    """The folder of the mesh cache, or None when it is turned off."""
+    root = cache_root()
+    return None if root is None else root / "meshes"
 
 
 @lru_cache(maxsize=1)
