@@ -222,3 +222,32 @@ def _contour_edges(faces: np.ndarray, lit: np.ndarray) -> np.ndarray:
     np.minimum.at(lo, inverse, face_lit)
     np.maximum.at(hi, inverse, face_lit)
     return (counts[inverse] == 1) | (lo[inverse] != hi[inverse])
+
+
+def shadows_nothing(vertices: np.ndarray, face_normals: np.ndarray, light: np.ndarray,
+                    boxes: list[np.ndarray], tolerance: float) -> bool:
+    """True when a planar caster's volume holds no receiver, so it can be skipped.
+
+    A flat caster (a floor, a wall: every face normal parallel, every vertex on one plane)
+    throws its volume into the half-space behind it, seen from the light. If every corner of
+    every receiver's bounding box ``boxes`` ((2, 3) min / max) lies on the light's side of
+    the plane (or within ``tolerance`` of it), no receiver surface is inside the volume and
+    its stencil count is 0 on every visible pixel: drawing it would only cost fill. The room
+    of a Cornell box and the floor under a lecture scene are such casters.
+    """
+    if len(face_normals) == 0:
+        return True
+    n = face_normals[0]
+    if np.abs(face_normals @ n).min() < 1.0 - 1e-9:
+        return False                                  # not flat
+    d = float(vertices[0] @ n)
+    if np.abs(vertices @ n - d).max() > tolerance:
+        return False
+    side = float(light[:3] @ n - light[3] * d)        # the light's side of the plane (+/-)
+    if abs(side) <= 1e-12:
+        return False                                  # a light in the plane: keep it
+    for box in boxes:
+        corners = np.array([[x, y, z] for x in box[:, 0] for y in box[:, 1] for z in box[:, 2]])
+        if np.any(np.sign(side) * (corners @ n - d) < -tolerance):
+            return False
+    return True

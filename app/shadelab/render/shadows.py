@@ -18,7 +18,12 @@ import moderngl
 import numpy as np
 
 from shadelab.geometry.mesh import scene_bounds
-from shadelab.geometry.silhouette import ShadowVolume, light_homogeneous, shadow_volume
+from shadelab.geometry.silhouette import (
+    ShadowVolume,
+    light_homogeneous,
+    shadow_volume,
+    shadows_nothing,
+)
 from shadelab.gl.programs import load_program, set_uniform
 from shadelab.scene.camera import gl_matrix
 from shadelab.scene.model import Light, Scene
@@ -86,7 +91,9 @@ class ShadowVolumes:
     # ------------------------------------------------------------ geometry
     def volumes(self, scene: Scene, gpu_meshes, light_index: int,
                 light: Light) -> list[CasterVolume]:
-        """The volumes of every shadow-casting object for one light (cached)."""
+        """The volumes of every shadow-casting object for one light (cached). A flat caster
+        with every other object on the light's side (a floor, a room's walls) is skipped: its
+        volume holds no receiver (:func:`shadows_nothing`), the stencil is the same."""
         offset = OFFSET_FRACTION * float(np.linalg.norm(np.ptp(
             scene_bounds([g.mesh for g in gpu_meshes]), axis=0)))
         homogeneous = light_homogeneous(light.kind, light.position, light.direction)
@@ -95,6 +102,10 @@ class ShadowVolumes:
         for gpu in gpu_meshes:
             obj = scene.objects[gpu.mesh.index] if gpu.mesh.index < len(scene.objects) else None
             if obj is None or not obj.cast_shadows:
+                continue
+            others = [g.bounds for g in gpu_meshes if g is not gpu]
+            if shadows_nothing(gpu.mesh.vertices, gpu.mesh.face_normals, homogeneous, others,
+                               offset):
                 continue
             slot = (gpu.mesh.index, light_index)
             key = (gpu.key, light_key(light), offset)

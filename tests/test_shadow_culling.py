@@ -1,0 +1,62 @@
+"""Flat casters whose volume holds no receiver are skipped (issue 13.5: shadow-volume fill).
+
+``shadows_nothing`` against closed cases, and the frames: skipping the floor under a lecture
+scene and the walls of a Cornell box changes no pixel."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from shadelab.geometry.silhouette import light_homogeneous, shadows_nothing
+from shadelab.scene import load_preset
+
+FLOOR = np.array([[-5, 0, -5], [5, 0, -5], [5, 0, 5], [-5, 0, 5]], float)
+UP = np.tile([0.0, 1.0, 0.0], (2, 1))
+ABOVE = np.array([[-1.0, 0.0, -1.0], [1.0, 2.0, 1.0]])     # a box standing on the floor
+BELOW = np.array([[-1.0, -2.0, -1.0], [1.0, -0.5, 1.0]])
+
+
+def test_a_floor_lit_from_above_shadows_nothing_above_it():
+    light = light_homogeneous("point", (0.0, 4.0, 0.0), None)
+    assert shadows_nothing(FLOOR, UP, light, [ABOVE], 1e-6)
+    assert not shadows_nothing(FLOOR, UP, light, [ABOVE, BELOW], 1e-6)   # a receiver below
+    below = light_homogeneous("point", (0.0, -4.0, 0.0), None)
+    assert not shadows_nothing(FLOOR, UP, below, [ABOVE], 1e-6)          # lit from beneath
+    sun = light_homogeneous("directional", None, (0.3, -1.0, 0.1))
+    assert shadows_nothing(FLOOR, UP, sun, [ABOVE], 1e-6)
+    grazing = light_homogeneous("point", (9.0, 0.0, 0.0), None)
+    assert not shadows_nothing(FLOOR, UP, grazing, [ABOVE], 1e-6)        # in the plane: kept
+
+
+def test_only_flat_casters_are_skipped():
+    bent = FLOOR.copy()
+    bent[2, 1] = 0.5
+    light = light_homogeneous("point", (0.0, 4.0, 0.0), None)
+    assert not shadows_nothing(bent, UP, light, [ABOVE], 1e-6)
+    tilted = np.array([[0.0, 1.0, 0.0], [0.0, 0.9, 0.436]])
+    assert not shadows_nothing(FLOOR, tilted, light, [ABOVE], 1e-6)
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("preset", ["lecture", "shadows", "shadows-colored", "cornell",
+                                    "cornell-spheres", "transparency"])
+def test_skipping_changes_no_pixel(gl_ctx, monkeypatch, preset):
+    from shadelab.render import shadows
+    from shadelab.render.offscreen import render_image, shared_renderer
+
+    scene = load_preset(preset, ["render.shadows=volumes"])
+    size = (96, 72)
+    culled = render_image(scene, size)
+    renderer = shared_renderer()
+    lights = scene.active_lights()
+    meshes = renderer.sync(scene)
+    kept = sum(len(renderer.shadow_volumes.volumes(scene, meshes, i, light))
+               for i, light in enumerate(lights))
+    monkeypatch.setattr(shadows, "shadows_nothing", lambda *a: False)
+    every = sum(len(renderer.shadow_volumes.volumes(scene, meshes, i, light))
+                for i, light in enumerate(lights))
+    full = render_image(scene, size)
+    np.testing.assert_array_equal(culled, full)
+    if preset in ("lecture", "shadows", "cornell"):
+        assert kept < every                 # the floor / the room's walls were skipped
