@@ -12,7 +12,7 @@ from shadelab.cli import main
 from shadelab.progress import Progress
 from shadelab.scene import load_preset
 from shadelab.scene.preset import scene_to_dict
-from shadelab.ui.app import orbit, pan, zoom
+from shadelab.ui.camera_control import orbit, pan, zoom
 from shadelab.ui.jobs import JobRunner, difference, iter_reference_raster
 from shadelab.ui.probe import probe
 from shadelab.ui.state import AppState, History, autosave_path, load_session, save_session

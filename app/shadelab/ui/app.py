@@ -9,7 +9,6 @@ snapshots, autosave, window title).
 from __future__ import annotations
 
 import json
-import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -19,8 +18,16 @@ import numpy as np
 from imgui_bundle import hello_imgui, imgui, immapp
 
 from shadelab.geometry.mesh import geometry_key, scene_meshes
-from shadelab.scene.model import Camera
-from shadelab.ui import gizmos, lesson, overlays, panels, pipelines, presenter, radiosity_view
+from shadelab.ui import (
+    camera_control,
+    gizmos,
+    lesson,
+    overlays,
+    panels,
+    pipelines,
+    presenter,
+    radiosity_view,
+)
 from shadelab.ui.frame import guarded
 from shadelab.ui.layout import focus_windows
 from shadelab.ui.offline import draw_offline_panel
@@ -35,10 +42,6 @@ from shadelab.ui.state import (
 )
 from shadelab.ui.studies_panel import draw_gallery_panel, draw_studies_panel
 
-ORBIT_SPEED = 0.008        # radians per pixel dragged, when no window height is given
-ORBIT_HALF_TURN = math.pi  # a drag across the viewport's height turns this much
-ZOOM_STEP = 0.9            # eye-target distance factor per wheel notch
-CLICK_SLOP = 3.0           # pixels a click may move and still probe
 PRESENTER_SCALE = 1.8      # font scale of presenter mode
 WARM_JOBS_AT_FRAME = 60    # start the offline-job process once the window is up
 WINDOW_BG = imgui.ImVec4(0.06, 0.06, 0.06, 1.0)  # the dark theme's panel color, opaque
@@ -64,52 +67,6 @@ class ViewerOptions:
     maximized: bool = False               # open maximized (no --window given)
     pipeline: str = ""                    # viewport pipeline at start (shadelab.ui.pipelines)
     test_function: Callable | None = None  # immapp.testing test body (GUI tests)
-
-
-# ---------------------------------------------------------------- camera moves
-
-
-def orbit(camera: Camera, dx: float, dy: float, height: int = 0) -> None:
-    """Turn the eye around the target: dx about the up axis, dy over the top. With the
-    viewport's ``height``, a drag across it turns ORBIT_HALF_TURN (180 degrees)."""
-    speed = ORBIT_HALF_TURN / height if height > 0 else ORBIT_SPEED
-    eye, target = np.asarray(camera.eye, float), np.asarray(camera.target, float)
-    up = np.asarray(camera.up, float) / np.linalg.norm(camera.up)
-    offset = eye - target
-    radius = np.linalg.norm(offset)
-    d = offset / radius
-    right = np.cross(up, d)
-    right = right / max(np.linalg.norm(right), 1e-12)
-    forward = np.cross(right, up)
-    elevation = math.asin(max(-1.0, min(1.0, float(np.dot(d, up)))))
-    azimuth = math.atan2(float(np.dot(d, right)), float(np.dot(d, forward)))
-    azimuth -= dx * speed
-    elevation = max(-1.5, min(1.5, elevation + dy * speed))
-    new_d = (math.cos(elevation) * (math.cos(azimuth) * forward + math.sin(azimuth) * right)
-             + math.sin(elevation) * up)
-    camera.eye = tuple(float(c) for c in target + radius * new_d)
-
-
-def pan(camera: Camera, dx: float, dy: float, height: int) -> None:
-    """Slide eye and target together so the scene follows the mouse."""
-    eye, target = np.asarray(camera.eye, float), np.asarray(camera.target, float)
-    forward = target - eye
-    distance = np.linalg.norm(forward)
-    forward /= distance
-    right = np.cross(forward, camera.up)
-    right /= np.linalg.norm(right)
-    up = np.cross(right, forward)
-    per_pixel = 2.0 * distance * math.tan(math.radians(camera.fov_y) / 2.0) / max(height, 1)
-    shift = (-dx * right + dy * up) * per_pixel
-    camera.eye = tuple(float(c) for c in eye + shift)
-    camera.target = tuple(float(c) for c in target + shift)
-
-
-def zoom(camera: Camera, notches: float) -> None:
-    eye, target = np.asarray(camera.eye, float), np.asarray(camera.target, float)
-    offset = (eye - target) * (ZOOM_STEP ** notches)
-    if np.linalg.norm(offset) > camera.near * 2.0:
-        camera.eye = tuple(float(c) for c in target + offset)
 
 
 # ---------------------------------------------------------------- shortcuts
@@ -325,16 +282,14 @@ class Viewer:
         if imgui.is_item_active():
             dx, dy = io.mouse_delta.x, io.mouse_delta.y
             self.drag += abs(dx) + abs(dy)
-            if self.drag > CLICK_SLOP and (dx or dy) and not gizmos.capturing():
-                if imgui.is_mouse_down(imgui.MouseButton_.left):
-                    orbit(camera, dx, dy, size[1])
-                else:
-                    pan(camera, dx, dy, size[1])
+            if self.drag > camera_control.CLICK_SLOP and (dx or dy) and not gizmos.capturing():
+                camera_control.drag(camera, dx, dy, imgui.is_mouse_down(imgui.MouseButton_.left),
+                                    size[1], size[1])
                 state.mark_edited()
         if imgui.is_item_hovered() and io.mouse_wheel:
-            zoom(camera, io.mouse_wheel)
+            camera_control.zoom(camera, io.mouse_wheel)
             state.mark_edited()
-        if imgui.is_item_deactivated() and self.drag <= CLICK_SLOP \
+        if imgui.is_item_deactivated() and self.drag <= camera_control.CLICK_SLOP \
                 and imgui.is_mouse_released(imgui.MouseButton_.left):
             mouse = io.mouse_pos
             return mouse.x - origin.x, mouse.y - origin.y
@@ -527,13 +482,11 @@ class Viewer:
                                | imgui.ButtonFlags_.mouse_button_right)
         camera = state.scene.camera
         if imgui.is_item_active() and (io.mouse_delta.x or io.mouse_delta.y):
-            if imgui.is_mouse_down(imgui.MouseButton_.left):
-                orbit(camera, io.mouse_delta.x, io.mouse_delta.y, size[1])
-            else:
-                pan(camera, io.mouse_delta.x, io.mouse_delta.y, pane_height)
+            camera_control.drag(camera, io.mouse_delta.x, io.mouse_delta.y,
+                                imgui.is_mouse_down(imgui.MouseButton_.left), size[1], pane_height)
             state.mark_edited()
         if imgui.is_item_hovered() and io.mouse_wheel:
-            zoom(camera, io.mouse_wheel)
+            camera_control.zoom(camera, io.mouse_wheel)
             state.mark_edited()
 
     # ------------------------------------------------------------ screenshots

@@ -1,0 +1,71 @@
+"""Camera control: what a mouse drag or a wheel notch does to the :class:`Camera`.
+
+Pure numpy beside the camera model (:mod:`shadelab.scene.camera`): no GL, no GUI. The viewer
+(:mod:`shadelab.ui.app`) turns ImGui mouse input into these calls.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from shadelab.scene.model import Camera
+
+ORBIT_SPEED = 0.008        # radians per pixel dragged, when no window height is given
+ORBIT_HALF_TURN = math.pi  # a drag across the viewport's height turns this much
+ZOOM_STEP = 0.9            # eye-target distance factor per wheel notch
+CLICK_SLOP = 3.0           # pixels a click may move and still probe
+
+
+def orbit(camera: Camera, dx: float, dy: float, height: int = 0) -> None:
+    """Turn the eye around the target: dx about the up axis, dy over the top. With the
+    viewport's ``height``, a drag across it turns ORBIT_HALF_TURN (180 degrees)."""
+    speed = ORBIT_HALF_TURN / height if height > 0 else ORBIT_SPEED
+    eye, target = np.asarray(camera.eye, float), np.asarray(camera.target, float)
+    up = np.asarray(camera.up, float) / np.linalg.norm(camera.up)
+    offset = eye - target
+    radius = np.linalg.norm(offset)
+    d = offset / radius
+    right = np.cross(up, d)
+    right = right / max(np.linalg.norm(right), 1e-12)
+    forward = np.cross(right, up)
+    elevation = math.asin(max(-1.0, min(1.0, float(np.dot(d, up)))))
+    azimuth = math.atan2(float(np.dot(d, right)), float(np.dot(d, forward)))
+    azimuth -= dx * speed
+    elevation = max(-1.5, min(1.5, elevation + dy * speed))
+    new_d = (math.cos(elevation) * (math.cos(azimuth) * forward + math.sin(azimuth) * right)
+             + math.sin(elevation) * up)
+    camera.eye = tuple(float(c) for c in target + radius * new_d)
+
+
+def pan(camera: Camera, dx: float, dy: float, height: int) -> None:
+    """Slide eye and target together so the scene follows the mouse."""
+    eye, target = np.asarray(camera.eye, float), np.asarray(camera.target, float)
+    forward = target - eye
+    distance = np.linalg.norm(forward)
+    forward /= distance
+    right = np.cross(forward, camera.up)
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    per_pixel = 2.0 * distance * math.tan(math.radians(camera.fov_y) / 2.0) / max(height, 1)
+    shift = (-dx * right + dy * up) * per_pixel
+    camera.eye = tuple(float(c) for c in eye + shift)
+    camera.target = tuple(float(c) for c in target + shift)
+
+
+def zoom(camera: Camera, notches: float) -> None:
+    """Scale the eye-target distance by ZOOM_STEP per notch (never closer than 2 x near)."""
+    eye, target = np.asarray(camera.eye, float), np.asarray(camera.target, float)
+    offset = (eye - target) * (ZOOM_STEP ** notches)
+    if np.linalg.norm(offset) > camera.near * 2.0:
+        camera.eye = tuple(float(c) for c in target + offset)
+
+
+def drag(camera: Camera, dx: float, dy: float, rotate: bool, orbit_height: int,
+         pan_height: int) -> None:
+    """A mouse drag: orbit with the left button (``rotate``), else pan."""
+    if rotate:
+        orbit(camera, dx, dy, orbit_height)
+    else:
+        pan(camera, dx, dy, pan_height)
