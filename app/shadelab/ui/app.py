@@ -8,7 +8,6 @@ snapshots, autosave, window title).
 
 from __future__ import annotations
 
-import json
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -32,6 +31,7 @@ from shadelab.ui.frame import guarded
 from shadelab.ui.layout import focus_windows
 from shadelab.ui.offline import draw_offline_panel
 from shadelab.ui.probe import probe
+from shadelab.ui.recorder import FrameRecorder
 from shadelab.ui.render_panel import draw_algorithms_panel
 from shadelab.ui.state import (
     AUTOSAVE_INTERVAL,
@@ -169,18 +169,10 @@ class Viewer:
     drag: float = 0.0                  # pixels moved since the mouse went down
     last_autosave: float = 0.0
     title: str = ""
-    frame_times: list = field(default_factory=list)
-    first_frame: float = 0.0
-    started: float = field(default_factory=time.perf_counter)
+    recorder: FrameRecorder = field(default_factory=FrameRecorder)  # frame times, the bench
     _line_cache: dict = field(default_factory=dict)
     _frame_key: tuple = ()
-    force_redraw: bool = False         # the bench's later phases: re-render every frame
-    force_interactive: bool = False    # the bench's last phase: as if a slider were dragged
-    redrawn: bool = False              # this frame re-rendered the scene
-    viewport_shown: bool = False       # the viewport window has drawn (first_frame counts)
     warm_after_first_frame: bool = False  # spawn the pipeline worker after the first frame
-    redraw_flags: list = field(default_factory=list)
-    cpu_times: list = field(default_factory=list)
     _job_followed_up: bool = False
     _study_done_at: int = 0            # frame the --study run ended
 
@@ -235,7 +227,8 @@ class Viewer:
         if self.options.autosave:
             self.autosave(force=True)
         if self.options.bench_json:
-            self.write_bench()
+            self.recorder.write(self.options.bench_json, self.options.window_size,
+                                pipelines.bench_report(self.state))  # jobs: first_image_s...
         if self.viewport is not None:
             self.viewport.release()
             self.viewport = None
@@ -255,8 +248,8 @@ class Viewer:
             self.draw_main(size)
         if not state.compare:
             gizmos.draw(state, origin, size)
-        presenter.draw_viewport_extras(state, origin, size, self.redrawn)
-        self.viewport_shown = True
+        presenter.draw_viewport_extras(state, origin, size, self.recorder.redrawn)
+        self.recorder.viewport_shown = True
         if state.error:
             imgui.set_cursor_pos(imgui.ImVec2(12, 40))
             imgui.text_colored(panels.ERROR_COLOR, f"Error: {state.error}")
@@ -307,10 +300,10 @@ class Viewer:
     def unchanged(self, size: tuple[int, int]) -> bool:
         """True when the last image is still right (idle frames only redraw the GUI)."""
         key = self.frame_key(size)
-        redraw = self.force_redraw or self.state.probe_requested \
+        redraw = self.recorder.force_redraw or self.state.probe_requested \
             or bool(self.state.screenshot_requested) or key != self._frame_key
         self._frame_key = key
-        self.redrawn = redraw
+        self.recorder.redrawn = redraw
         return not redraw
 
     def draw_main(self, size: tuple[int, int]) -> None:
@@ -363,7 +356,8 @@ class Viewer:
 
     def interacting(self) -> bool:
         """A slider or the camera is being dragged right now."""
-        return self.force_interactive or (self.state.edit_pending and imgui.is_any_item_active())
+        return self.recorder.force_interactive or (self.state.edit_pending
+                                                   and imgui.is_any_item_active())
 
     def render_size(self, size: tuple[int, int]) -> tuple[int, int]:
         """The scene's resolution: the viewport's times the render scale (lower mid-drag)."""
@@ -538,10 +532,7 @@ class Viewer:
                 and state.job.worker is not None:
             state.job.worker.warm()  # after start-up: the first job then starts at once
         if self.options.bench_json and self.options.frames:
-            # Phases: idle (GUI only), full-resolution redraw, interactive (drag) redraw.
-            third = self.options.frames // 3
-            self.force_redraw = state.frame >= third
-            self.force_interactive = state.frame >= 2 * third
+            self.recorder.set_phase(state.frame, self.options.frames)
         waiting = self.options.job and (state.job.running or not state.job.started
                                         or state.job_version != state.job.version)
         waiting = waiting or bool(self.options.pipeline and pipelines.busy(state))
@@ -560,18 +551,9 @@ class Viewer:
             hello_imgui.get_runner_params().app_shall_exit = True
 
     def frame_swapped(self) -> None:
-        """After the frame is on screen: its time, CPU time and whether it re-rendered the
-        scene. The first frame counts once the viewport has drawn (the very first frames
-        only lay out the dock space and show no scene)."""
-        now = time.perf_counter()
-        if not self.first_frame and self.viewport_shown:
-            self.first_frame = now
-            if self.warm_after_first_frame:
-                pipelines.warm(self.state)  # the job process imports while the user looks
-        self.frame_times.append(now)
-        self.cpu_times.append(time.process_time())
-        self.redraw_flags.append(0 if not self.redrawn else (2 if self.force_interactive else 1))
-        self.redrawn = False
+        """After the frame is on screen (:meth:`FrameRecorder.frame_swapped`)."""
+        if self.recorder.frame_swapped() and self.warm_after_first_frame:
+            pipelines.warm(self.state)  # the job process imports while the user looks
 
     def follow_up_job(self) -> None:
         """The command line's after-job requests: radiosity in the viewport, a ray tree."""
@@ -609,35 +591,6 @@ class Viewer:
             glfw.set_window_title(glfw_utils.glfw_window_hello_imgui(), title)
         except Exception:  # no GLFW backend (tests with a mock): the title is cosmetic
             pass
-
-    def write_bench(self) -> None:
-        """Frame times of idle frames (GUI only) and of frames that re-render the scene."""
-        times = np.diff(np.asarray(self.frame_times)) * 1000.0
-        flags = np.asarray(self.redraw_flags[1:])
-        report = {"first_frame_s": self.first_frame_since_start(),
-                  "frames": len(self.frame_times), "window": list(self.options.window_size)}
-        cpu = np.diff(np.asarray(self.cpu_times)) * 1000.0
-        for name, select in (("idle", flags == 0), ("redraw", flags == 1),
-                             ("interactive", flags == 2)):
-            picked, picked_cpu = times[select][5:], cpu[select][5:]  # skip warm-up frames
-            if len(picked):
-                report[f"{name}_frame_ms_median"] = float(np.median(picked))
-                report[f"{name}_frame_ms_max"] = float(np.max(picked))
-                report[f"{name}_cpu_ms_median"] = float(np.median(picked_cpu))
-        report.update(pipelines.bench_report(self.state))  # jobs: first_image_s, done_s
-        Path(self.options.bench_json).write_text(json.dumps(report), encoding="utf-8")
-
-    def first_frame_since_start(self) -> float:
-        """Seconds from process start to the first frame (Linux /proc; else since Viewer())."""
-        try:
-            import os
-
-            ticks = os.sysconf("SC_CLK_TCK")
-            start = int(Path("/proc/self/stat").read_text().rsplit(")", 1)[1].split()[19]) / ticks
-            uptime_now = float(Path("/proc/uptime").read_text().split()[0])
-            return uptime_now - start - (time.perf_counter() - self.first_frame)
-        except (OSError, ValueError, IndexError):
-            return self.first_frame - self.started
 
 
 # ---------------------------------------------------------------- layout and run
