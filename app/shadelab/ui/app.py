@@ -27,8 +27,8 @@ from shadelab.ui import (
     presenter,
     radiosity_view,
 )
+from shadelab.ui.followups import FollowUps, ViewerOptions, write_window_screenshot
 from shadelab.ui.frame import guarded
-from shadelab.ui.layout import focus_windows
 from shadelab.ui.offline import draw_offline_panel
 from shadelab.ui.probe import probe
 from shadelab.ui.recorder import FrameRecorder
@@ -45,28 +45,6 @@ from shadelab.ui.studies_panel import draw_gallery_panel, draw_studies_panel
 PRESENTER_SCALE = 1.8      # font scale of presenter mode
 WARM_JOBS_AT_FRAME = 60    # start the offline-job process once the window is up
 WINDOW_BG = imgui.ImVec4(0.06, 0.06, 0.06, 1.0)  # the dark theme's panel color, opaque
-
-
-@dataclass
-class ViewerOptions:
-    """Command-line extras: scripted frames, screenshots, tests and the bench."""
-
-    frames: int = 0                       # quit after this many frames (0: run until closed)
-    screenshot: str = ""                  # whole-window PNG written at exit
-    window_size: tuple[int, int] = (1600, 900)
-    probe: tuple[int, int] | None = None  # viewport pixel probed at start
-    job: str = ""                         # offline job started at start (label prefix)
-    bench_json: str = ""                  # frame times written here at exit
-    autosave: bool = True
-    show_radiosity: bool = False          # once a radiosity job ends, show its solution
-    ray_tree: tuple[int, int] | None = None  # once a Whitted job ends, trace this pixel's tree
-    focus: str = ""                       # dock windows brought to front at start (a,b,...)
-    study: str = ""                       # study run (quick) at start; --frames counts after it
-    gallery: str = ""                     # failure-gallery case selected and opened at start
-    fullscreen: bool = False              # open fullscreen at the monitor's resolution
-    maximized: bool = False               # open maximized (no --window given)
-    pipeline: str = ""                    # viewport pipeline at start (shadelab.ui.pipelines)
-    test_function: Callable | None = None  # immapp.testing test body (GUI tests)
 
 
 # ---------------------------------------------------------------- shortcuts
@@ -173,8 +151,10 @@ class Viewer:
     _line_cache: dict = field(default_factory=dict)
     _frame_key: tuple = ()
     warm_after_first_frame: bool = False  # spawn the pipeline worker after the first frame
-    _job_followed_up: bool = False
-    _study_done_at: int = 0            # frame the --study run ended
+    followups: FollowUps = field(init=False)  # what the command line asked for
+
+    def __post_init__(self) -> None:
+        self.followups = FollowUps(self.options)
 
     # ------------------------------------------------------------ GL lifetime
     def post_init(self) -> None:
@@ -189,34 +169,8 @@ class Viewer:
         from shadelab.ui.dialogs import install_drop_callback
 
         install_drop_callback()
-        if self.options.probe is not None:
-            self.state.probe_pixel, self.state.probe_requested = self.options.probe, True
-        if self.options.focus:
-            focus_windows(hello_imgui.get_runner_params().docking_params.dockable_windows,
-                          self.options.focus)
-        if self.options.gallery:
-            self._open_gallery_case(self.options.gallery)
-        if self.options.study:
-            from shadelab.ui.studies_panel import start_study
-
-            start_study(self.state, self.options.study)
-        if self.options.job:
-            from shadelab.ui.offline import start_job_by_label
-
-            start_job_by_label(self.state, self.options.job)
-        if self.options.pipeline:
-            pipelines.set_pipeline(self.state, self.options.pipeline)
-
-    def _open_gallery_case(self, name: str) -> None:
-        from shadelab.studies.gallery import GALLERY
-        from shadelab.ui.studies import open_case
-
-        names = [case.name for case in GALLERY]
-        if name not in names:
-            self.state.error = f"--gallery '{name}': expected one of {', '.join(names)}"
-            return
-        self.state.gallery_index = names.index(name)
-        open_case(self.state, GALLERY[self.state.gallery_index])
+        self.followups.start(self.state,
+                             hello_imgui.get_runner_params().docking_params.dockable_windows)
 
     def before_exit(self) -> None:
         self.state.job.shutdown()
@@ -533,37 +487,13 @@ class Viewer:
             state.job.worker.warm()  # after start-up: the first job then starts at once
         if self.options.bench_json and self.options.frames:
             self.recorder.set_phase(state.frame, self.options.frames)
-        waiting = self.options.job and (state.job.running or not state.job.started
-                                        or state.job_version != state.job.version)
-        waiting = waiting or bool(self.options.pipeline and pipelines.busy(state))
-        if state.study is not None:
-            state.study.poll()  # also while the Studies tab is hidden
-            if self.options.study and not self._study_done_at and not state.study.running:
-                self._study_done_at = state.frame
-            # --frames counts after the study ends (the plot fits its axes over a few frames)
-            waiting = waiting or (self.options.study and (
-                state.study.running
-                or state.frame < self._study_done_at + min(self.options.frames, 10)))
-        if self.options.job and not waiting and not self._job_followed_up:
-            self._job_followed_up = True
-            self.follow_up_job()
-        if self.options.frames and state.frame >= self.options.frames and not waiting:
+        if self.followups.end_frame(state):  # --frames done (after --job, --study...)
             hello_imgui.get_runner_params().app_shall_exit = True
 
     def frame_swapped(self) -> None:
         """After the frame is on screen (:meth:`FrameRecorder.frame_swapped`)."""
         if self.recorder.frame_swapped() and self.warm_after_first_frame:
             pipelines.warm(self.state)  # the job process imports while the user looks
-
-    def follow_up_job(self) -> None:
-        """The command line's after-job requests: radiosity in the viewport, a ray tree."""
-        state = self.state
-        if self.options.show_radiosity and state.radiosity_soup is not None:
-            state.show_radiosity = True
-        if self.options.ray_tree is not None and state.job_scene is not None:
-            from shadelab.ui.offline import trace_tree
-
-            trace_tree(state, self.options.ray_tree)
 
     def autosave(self, force: bool = False) -> None:
         state = self.state
@@ -714,9 +644,5 @@ def run_viewer(state: AppState, options: ViewerOptions) -> int:
     else:
         immapp.run(params, addons)
     if options.screenshot:
-        from PIL import Image
-
-        image = hello_imgui.final_app_window_screenshot()
-        Image.fromarray(image).save(options.screenshot)
-        print(f"wrote {options.screenshot} ({image.shape[1]}x{image.shape[0]})")
+        write_window_screenshot(options.screenshot)
     return 0

@@ -1,0 +1,122 @@
+"""Command-line follow-ups of ``shadelab view``: what ``--probe``, ``--focus``, ``--gallery``,
+``--study``, ``--job`` and ``--pipeline`` start once the window is up, what ``--show-radiosity``
+and ``--ray-tree`` do once the job ends, when ``--frames`` lets the viewer quit (after the job,
+the pipeline and the study are done) and the ``--screenshot`` written at exit.
+
+The Viewer (:mod:`shadelab.ui.app`) holds one :class:`FollowUps`; no GL here.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+from shadelab.ui import pipelines
+from shadelab.ui.state import AppState
+
+
+@dataclass
+class ViewerOptions:
+    """Command-line extras: scripted frames, screenshots, tests and the bench."""
+
+    frames: int = 0                       # quit after this many frames (0: run until closed)
+    screenshot: str = ""                  # whole-window PNG written at exit
+    window_size: tuple[int, int] = (1600, 900)
+    probe: tuple[int, int] | None = None  # viewport pixel probed at start
+    job: str = ""                         # offline job started at start (label prefix)
+    bench_json: str = ""                  # frame times written here at exit
+    autosave: bool = True
+    show_radiosity: bool = False          # once a radiosity job ends, show its solution
+    ray_tree: tuple[int, int] | None = None  # once a Whitted job ends, trace this pixel's tree
+    focus: str = ""                       # dock windows brought to front at start (a,b,...)
+    study: str = ""                       # study run (quick) at start; --frames counts after it
+    gallery: str = ""                     # failure-gallery case selected and opened at start
+    fullscreen: bool = False              # open fullscreen at the monitor's resolution
+    maximized: bool = False               # open maximized (no --window given)
+    pipeline: str = ""                    # viewport pipeline at start (shadelab.ui.pipelines)
+    test_function: Callable | None = None  # immapp.testing test body (GUI tests)
+
+
+def open_gallery_case(state: AppState, name: str) -> None:
+    """``--gallery NAME``: select the failure-gallery case and open it in the viewer."""
+    from shadelab.studies.gallery import GALLERY
+    from shadelab.ui.studies import open_case
+
+    names = [case.name for case in GALLERY]
+    if name not in names:
+        state.error = f"--gallery '{name}': expected one of {', '.join(names)}"
+        return
+    state.gallery_index = names.index(name)
+    open_case(state, GALLERY[state.gallery_index])
+
+
+@dataclass
+class FollowUps:
+    options: ViewerOptions
+    job_followed_up: bool = False
+    study_done_at: int = 0             # frame the --study run ended
+
+    def start(self, state: AppState, dockable_windows: list) -> None:
+        """Once the window (and its GL) is up: the start-up requests of the command line."""
+        options = self.options
+        if options.probe is not None:
+            state.probe_pixel, state.probe_requested = options.probe, True
+        if options.focus:
+            from shadelab.ui.layout import focus_windows
+
+            focus_windows(dockable_windows, options.focus)
+        if options.gallery:
+            open_gallery_case(state, options.gallery)
+        if options.study:
+            from shadelab.ui.studies_panel import start_study
+
+            start_study(state, options.study)
+        if options.job:
+            from shadelab.ui.offline import start_job_by_label
+
+            start_job_by_label(state, options.job)
+        if options.pipeline:
+            pipelines.set_pipeline(state, options.pipeline)
+
+    def waiting(self, state: AppState) -> bool:
+        """A job, pipeline or study the command line started is not done yet (``--frames``
+        counts after it; the study's plot fits its axes over a few frames more)."""
+        options = self.options
+        waiting = bool(options.job) and (state.job.running or not state.job.started
+                                         or state.job_version != state.job.version)
+        waiting = waiting or bool(options.pipeline and pipelines.busy(state))
+        if state.study is not None:
+            state.study.poll()  # also while the Studies tab is hidden
+            if options.study and not self.study_done_at and not state.study.running:
+                self.study_done_at = state.frame
+            waiting = waiting or bool(options.study and (
+                state.study.running
+                or state.frame < self.study_done_at + min(options.frames, 10)))
+        return waiting
+
+    def end_frame(self, state: AppState) -> bool:
+        """Once a frame: the after-job requests; True when ``--frames`` says quit now."""
+        waiting = self.waiting(state)
+        if self.options.job and not waiting and not self.job_followed_up:
+            self.job_followed_up = True
+            self.follow_up_job(state)
+        return bool(self.options.frames) and state.frame >= self.options.frames and not waiting
+
+    def follow_up_job(self, state: AppState) -> None:
+        """The command line's after-job requests: radiosity in the viewport, a ray tree."""
+        if self.options.show_radiosity and state.radiosity_soup is not None:
+            state.show_radiosity = True
+        if self.options.ray_tree is not None and state.job_scene is not None:
+            from shadelab.ui.offline import trace_tree
+
+            trace_tree(state, self.options.ray_tree)
+
+
+def write_window_screenshot(path: str) -> None:
+    """``--screenshot PATH``: the whole window's last frame, written after the window closed."""
+    from imgui_bundle import hello_imgui
+    from PIL import Image
+
+    image = hello_imgui.final_app_window_screenshot()
+    Image.fromarray(image).save(path)
+    print(f"wrote {path} ({image.shape[1]}x{image.shape[0]})")
