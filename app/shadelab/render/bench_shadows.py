@@ -1,5 +1,6 @@
 """Shadow benchmark: cornell at 800x600, Phong, stencil shadow volumes for its point light,
-and the same frame without shadows in the same run (goal: shadowed <= 2.5x unshadowed).
+and the same frame without shadows in the same run (goal: shadowed <= 2.5x unshadowed), and
+the shadows / shadows-colored presets with m lights against issue 13.5's (1 + 0.6 m)x.
 
 Frames end with ``ctx.finish()`` so the GPU (or llvmpipe) work is inside the timing. Also
 reports the shadow-volume geometry sizes and the other shadow presets for context.
@@ -55,6 +56,11 @@ def run(quick: bool) -> dict:
                 result[f"{name}_volumes"] = _frame_timer(renderer, target, scene, 10)
                 scene.render.shadows = "none"
                 result[f"{name}_no_shadows"] = _frame_timer(renderer, target, scene, 10)
+                m = len(scene.active_lights())
+                result[f"{name}_ratio"] = round(result[f"{name}_volumes"]["median_ms"]
+                                                / result[f"{name}_no_shadows"]["median_ms"], 3)
+                result[f"{name}_goal_ratio"] = 1.0 + 0.6 * m      # issue 13.5, m lights
+                result[f"{name}_lights"] = m
         return result
     finally:
         target.release()
