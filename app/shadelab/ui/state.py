@@ -1,17 +1,19 @@
-"""The viewer's state: one dataclass, plus undo history and the autosaved session.
+"""The viewer's state: :class:`AppState` made of typed sub-states (view, probe, job, study,
+lesson), plus undo history and the autosaved session.
 
 Pure module (no GL, no GUI): the panels read and write an :class:`AppState`; the GL side keeps
-its resources elsewhere (:mod:`shadelab.ui.viewport`).
+its resources elsewhere (:mod:`shadelab.ui.viewport`; ``AppState.gl`` is only a handle to it,
+imported for its type alone).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 from shadelab.errors import ShadeLabError
-from shadelab.scene.model import Scene
+from shadelab.scene.model import Camera, Scene
 from shadelab.scene.preset import clone_scene, load_preset, save_preset, scene_to_dict
 
 # One file, written atomically; a damaged one is moved aside and never stops the viewer
@@ -23,6 +25,17 @@ from shadelab.ui.session import (  # noqa: F401
     save_session,
     state_dir,
 )
+
+if TYPE_CHECKING:  # types only (no import at run time: the GL side stays out of this module)
+    import numpy as np
+
+    from shadelab.raytrace.tree import RayNode
+    from shadelab.ui.jobs import JobKind, JobRunner
+    from shadelab.ui.lesson_file import LessonRun
+    from shadelab.ui.pipeline_view import PipelineView
+    from shadelab.ui.probe import ProbeResult
+    from shadelab.ui.studies import StudyRun
+    from shadelab.ui.viewport import Viewport
 
 COMPARE_VIEWS = (("flat", "phong"), ("gouraud", "phong"), ("phong", "phong"), ("phong", "blinn"))
 COMPARE_LABELS = ("Flat", "Gouraud", "Phong", "Blinn-Phong")
@@ -81,19 +94,14 @@ class History:
         return clone_scene(self.snapshots[self.index])
 
 
-# ---------------------------------------------------------------- the app state
+# ---------------------------------------------------------------- sub-states
 
 
 @dataclass
-class AppState:
-    """Everything the panels show and edit; one instance per viewer window."""
+class ViewState:
+    """How the viewport shows the scene: overlays, compare layout, resolution, presenter
+    display options (shadelab.ui.presenter) and the viewport pipeline (shadelab.ui.pipelines)."""
 
-    scene: Scene
-    source: str                       # preset name or file the scene came from
-    saved: dict = field(default_factory=dict)      # scene_to_dict at the last load/save
-    initial_camera: Any = None        # the preset's camera, for "reset view"
-    history: History | None = None
-    # View options
     show_wireframe: bool = False
     show_normals: bool = False
     normal_length: float = 0.04       # glyph length, share of the scene's diagonal
@@ -106,58 +114,7 @@ class AppState:
     interactive_scale: float = 0.5    # the same while a slider or the camera is dragged
     show_help: bool = False
     legend_in_screenshot: bool = True
-    # Probe
-    probe_pixel: tuple[int, int] | None = None
-    probe: Any = None                 # shadelab.ui.probe.ProbeResult
-    probe_requested: bool = False
-    probe_version: int = 0            # bumped on every new probe result
-    # Messages
-    error: str = ""                   # shown in the app (bad preset, bad mesh...)
-    status: str = ""                  # last action ("saved ...", "screenshot ...")
-    # Files
-    preset_path: str = ""             # "Save" writes here
-    open_path: str = ""               # text field of the open/save box
-    screenshot_dir: str = "."
-    screenshot_requested: str = ""    # a path: the viewport is written there next frame
-    # Bookkeeping
-    dirty: bool = False               # unsaved changes (vs the preset or last save)
-    edit_pending: bool = False        # an edit not yet in the undo history
-    autosave_due: bool = False
-    frame: int = 0
     viewport_size: tuple[int, int] = (0, 0)
-    job: Any = None                   # shadelab.ui.jobs.JobRunner
-    job_kind: int = 0
-    job_size: int = 128
-    job_spp: int = 16                 # samples per pixel (path tracer; Whitted anti-aliasing)
-    job_compare: Any = None           # dict of error figures vs the raster view
-    job_raster: Any = None            # (H, W, 3) raster image the job is compared with
-    job_kinds: Any = None             # shadelab.ui.jobs.available_jobs(), found on first use
-    job_version: int = -1             # the JobRunner version last uploaded
-    gl: Any = None                    # shadelab.ui.viewport.Viewport (GL thread only)
-    job_scene: Any = None             # the Scene snapshot the last job rendered
-    job_size_px: tuple = (0, 0)       # its image size (width, height)
-    ray_tree: Any = None              # shadelab.raytrace.tree.RayNode of a clicked traced pixel
-    ray_tree_pixel: Any = None        # (x, y) in the job image
-    radiosity_soup: Any = None        # (3F, 6) float32 solved display triangles (radiance)
-    show_radiosity: bool = False      # draw the radiosity solution instead of the raster
-    overlay_version: int = 0          # bumped when the ray tree or radiosity solution changes
-    # Viewport pipeline (shadelab.ui.pipelines): gouraud, phong, painter, radiosity, raytrace,
-    # pathtrace; "" = the raster pipeline the scene's shading and visibility name
-    pipeline: str = ""
-    wipe: bool = False                # compare the pipeline with wipe_pipeline under one camera
-    wipe_pipeline: str = "raytrace"
-    wipe_position: float = 0.5        # share of the viewport's width left of the wipe line
-    radiosity_patches: bool = False   # radiosity pipeline: draw the patch edges
-    pipeline_view: Any = None         # shadelab.ui.pipelines.PipelineView (jobs, images)
-    # Studies and failure gallery panels (shadelab.ui.studies_panel)
-    study: Any = None                 # shadelab.ui.studies.StudyRun, made on first use
-    study_index: int = 0              # into shadelab.studies.STUDIES
-    study_chart: int = 0              # 0: the main chart; i: the result's i-th extra table
-    study_plotted: int = 0            # points the Studies chart drew last frame
-    study_budget: float = 0.01        # auto quality's error budget (relative MSE)
-    gallery_index: int = -1           # selected case of shadelab.studies.gallery.GALLERY
-    gallery_opened: str = ""          # name of the last case opened in the viewer
-    # Presenter (shadelab.ui.presenter), lessons (shadelab.ui.lesson), dialogs
     hide_panels: bool = False         # Tab: the viewport alone, with a caption
     fullscreen: bool = False          # F11 / --fullscreen: the monitor's resolution
     tonemap: str = "clamp"            # display: clamp | reinhard
@@ -167,18 +124,135 @@ class AppState:
     msaa: int = 1                     # MSAA samples of the scene pass (1, 2, 4, 8)
     msaa_limit: int = 0               # the most the GL allows (0: not known yet)
     line_width: float = 0.0           # overlay lines, pixels (0: by the presenter scale)
-    lesson: Any = None                # shadelab.ui.lesson.LessonRun
-    pending_open: str = ""            # a file asked for while there are unsaved edits
-    scene_version: int = 0            # bumped by every scene edit and load
     show_gizmos: bool = True          # light gizmos in the viewport
-    focus_request: str = ""           # panels to bring to the front next frame (a,b,...)
     gizmo_light: int = 0              # the light the viewport gizmo moves
+    # Viewport pipeline: gouraud, phong, painter, radiosity, raytrace, pathtrace; "" = the
+    # raster pipeline the scene's shading and visibility name
+    pipeline: str = ""
+    wipe: bool = False                # compare the pipeline with wipe_pipeline under one camera
+    wipe_pipeline: str = "raytrace"
+    wipe_position: float = 0.5        # share of the viewport's width left of the wipe line
+    radiosity_patches: bool = False   # radiosity pipeline: draw the patch edges
+    pipeline_view: PipelineView | None = None  # the pipeline's jobs and images
+
+
+@dataclass
+class ProbeState:
+    """The probed pixel and what the probe found there (shadelab.ui.probe)."""
+
+    probe_pixel: tuple[int, int] | None = None
+    probe: ProbeResult | None = None
+    probe_requested: bool = False
+    probe_version: int = 0            # bumped on every new probe result
+
+
+@dataclass
+class JobState:
+    """The Offline render panel's job and what it left: the image's comparison with the raster
+    view, a clicked pixel's ray tree, the solved radiosity triangles (shadelab.ui.offline)."""
+
+    job: JobRunner | None = None
+    job_kind: int = 0
+    job_size: int = 128
+    job_spp: int = 16                 # samples per pixel (path tracer; Whitted anti-aliasing)
+    job_compare: dict | None = None   # error figures vs the raster view
+    job_raster: np.ndarray | None = None  # (H, W, 3) raster image the job is compared with
+    job_kinds: list[JobKind] | None = None  # shadelab.ui.jobs.available_jobs(), on first use
+    job_version: int = -1             # the JobRunner version last uploaded
+    job_scene: Scene | None = None    # the Scene snapshot the last job rendered
+    job_size_px: tuple = (0, 0)       # its image size (width, height)
+    ray_tree: RayNode | None = None   # the ray tree of a clicked traced pixel
+    ray_tree_pixel: tuple[int, int] | None = None  # (x, y) in the job image
+    radiosity_soup: np.ndarray | None = None  # (3F, 6) float32 solved display triangles
+    show_radiosity: bool = False      # draw the radiosity solution instead of the raster
+    overlay_version: int = 0          # bumped when the ray tree or radiosity solution changes
+
+
+@dataclass
+class StudyState:
+    """The Studies and Failure gallery panels (shadelab.ui.studies_panel)."""
+
+    study: StudyRun | None = None     # made on first use
+    study_index: int = 0              # into shadelab.studies.STUDIES
+    study_chart: int = 0              # 0: the main chart; i: the result's i-th extra table
+    study_plotted: int = 0            # points the Studies chart drew last frame
+    study_budget: float = 0.01        # auto quality's error budget (relative MSE)
+    gallery_index: int = -1           # selected case of shadelab.studies.gallery.GALLERY
+    gallery_opened: str = ""          # name of the last case opened in the viewer
+
+
+@dataclass
+class LessonState:
+    """The lesson walked through with PageDown / PageUp (shadelab.ui.lesson)."""
+
+    lesson: LessonRun | None = None
+    focus_request: str = ""           # panels to bring to the front next frame (a,b,...)
+
+
+class _In:
+    """An AppState attribute kept in one of its sub-states: ``state.show_wireframe`` reads and
+    writes ``state.view_state.show_wireframe`` (the panels' names stay as they were)."""
+
+    def __init__(self, part: str, name: str):
+        self.part, self.name = part, name
+
+    def __get__(self, obj, objtype=None):
+        if obj is None:
+            return self
+        return getattr(getattr(obj, self.part), self.name)
+
+    def __set__(self, obj, value) -> None:
+        setattr(getattr(obj, self.part), self.name, value)
+
+
+SUB_STATES = {"view_state": ViewState, "probe_state": ProbeState, "job_state": JobState,
+              "study_state": StudyState, "lesson_state": LessonState}
+
+
+# ---------------------------------------------------------------- the app state
+
+
+@dataclass
+class AppState:
+    """Everything the panels show and edit; one instance per viewer window.
+
+    The panels read and write the sub-states' fields under their old names (``state.compare``
+    is ``state.view_state.compare``); see :data:`SUB_STATES`."""
+
+    scene: Scene
+    source: str                       # preset name or file the scene came from
+    saved: dict = field(default_factory=dict)      # scene_to_dict at the last load/save
+    initial_camera: Camera | None = None  # the preset's camera, for "reset view"
+    history: History | None = None
+    view_state: ViewState = field(default_factory=ViewState)
+    probe_state: ProbeState = field(default_factory=ProbeState)
+    job_state: JobState = field(default_factory=JobState)
+    study_state: StudyState = field(default_factory=StudyState)
+    lesson_state: LessonState = field(default_factory=LessonState)
+    # Messages
+    error: str = ""                   # shown in the app (bad preset, bad mesh...)
+    status: str = ""                  # last action ("saved ...", "screenshot ...")
+    # Files
+    preset_path: str = ""             # "Save" writes here
+    open_path: str = ""               # text field of the open/save box
+    screenshot_dir: str = "."
+    screenshot_requested: str = ""    # a path: the viewport is written there next frame
+    pending_open: str = ""            # a file asked for while there are unsaved edits
+    # Bookkeeping
+    dirty: bool = False               # unsaved changes (vs the preset or last save)
+    edit_pending: bool = False        # an edit not yet in the undo history
+    autosave_due: bool = False
+    frame: int = 0
+    scene_version: int = 0            # bumped by every scene edit and load
+    gl: Viewport | None = None        # the GL side (GL thread only; the Viewer sets it)
 
     @classmethod
     def from_scene(cls, scene: Scene, source: str, **kwargs) -> "AppState":
         from shadelab.ui.jobs import JobRunner
 
-        state = cls(scene=scene, source=source, **kwargs)
+        state = cls(scene=scene, source=source)
+        for name, value in kwargs.items():  # a sub-state's field, by its old name, too
+            setattr(state, name, value)
         state.saved = scene_to_dict(scene)
         state.initial_camera = clone_scene(scene).camera
         state.history = History(scene, state.file_meta())
@@ -331,3 +405,10 @@ class AppState:
         """Window title: the preset, with a star while there are unsaved changes."""
         name = self.scene.name or Path(self.source).stem
         return f"ShadeLab - {name}{' *' if self.dirty else ''}"
+
+
+# The sub-states' fields under their old names (``state.compare``, ``state.probe_pixel``...).
+for _part, _cls in SUB_STATES.items():
+    for _name in _cls.__dataclass_fields__:
+        setattr(AppState, _name, _In(_part, _name))
+del _part, _cls, _name

@@ -1,0 +1,114 @@
+"""Lesson files and the walk through them: :class:`Step`, :class:`Lesson`, :func:`load_lesson`
+and :class:`LessonRun` (data only: no state, no GL, no GUI). :mod:`shadelab.ui.lesson` shows
+the steps in the viewer; the file format is described there."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from shadelab.errors import ShadeLabError
+from shadelab.scene.model import Scene
+from shadelab.scene.preset import load_preset, read_toml
+
+STEP_KEYS = {"title", "caption", "preset", "set", "pipeline", "focus"}
+
+
+def lessons_dir() -> Path:
+    from shadelab.resources import presets_dir
+
+    return Path(presets_dir()) / "lessons"
+
+
+def list_lessons() -> list[str]:
+    return sorted(p.stem for p in lessons_dir().glob("*.toml"))
+
+
+@dataclass
+class Step:
+    title: str
+    caption: str
+    preset: str
+    set: list[str] = field(default_factory=list)
+    pipeline: str = ""
+    focus: str = ""
+
+
+@dataclass
+class Lesson:
+    name: str
+    steps: list[Step]
+    path: str = ""
+
+
+def resolve_lesson(name_or_path: str) -> Path:
+    path = Path(name_or_path)
+    if path.suffix == ".toml" or "/" in name_or_path:
+        if not path.is_file():
+            raise ShadeLabError(f"lesson '{name_or_path}': file not found")
+        return path
+    path = lessons_dir() / f"{name_or_path}.toml"
+    if not path.is_file():
+        raise ShadeLabError(f"lesson '{name_or_path}': expected one of "
+                            f"{', '.join(list_lessons()) or '(none shipped)'}, or a .toml path")
+    return path
+
+
+def load_lesson(name_or_path: str, check: bool = True) -> Lesson:
+    """Read and check a lesson file (every step's preset loads with its overrides)."""
+    path = resolve_lesson(name_or_path)
+    raw = read_toml(path)
+    where = path.name
+    steps_raw = raw.get("steps")
+    if not isinstance(steps_raw, list) or not steps_raw:
+        raise ShadeLabError(f"{where}: expected at least one [[steps]] table")
+    steps = []
+    for i, item in enumerate(steps_raw):
+        if not isinstance(item, dict):
+            raise ShadeLabError(f"{where}: steps[{i}]: expected a table")
+        unknown = set(item) - STEP_KEYS
+        if unknown:
+            raise ShadeLabError(f"{where}: steps[{i}]: unknown key '{sorted(unknown)[0]}' "
+                                f"(expected {', '.join(sorted(STEP_KEYS))})")
+        for key in ("title", "caption", "preset"):
+            if not isinstance(item.get(key), str) or not item[key]:
+                raise ShadeLabError(f"{where}: steps[{i}]: '{key}' must be a non-empty string")
+        overrides = item.get("set", [])
+        if not isinstance(overrides, list) or not all(isinstance(s, str) for s in overrides):
+            raise ShadeLabError(f"{where}: steps[{i}]: 'set' must be a list of KEY=VALUE strings")
+        preset = item["preset"]
+        if not Path(preset).is_absolute() and preset.endswith(".toml"):
+            preset = str(path.parent / preset)  # a preset file next to the lesson
+        steps.append(Step(item["title"], item["caption"], preset, list(overrides),
+                          str(item.get("pipeline", "")), str(item.get("focus", ""))))
+    lesson = Lesson(str(raw.get("name", path.stem)), steps, str(path))
+    if check:
+        for i, step in enumerate(lesson.steps):
+            try:
+                step_scene(step)
+            except ShadeLabError as exc:
+                raise ShadeLabError(f"{where}: steps[{i}] ('{step.title}'): {exc}") from None
+    return lesson
+
+
+def step_scene(step: Step) -> Scene:
+    return load_preset(step.preset, step.set)
+
+
+@dataclass
+class LessonRun:
+    """A lesson being walked: which step is shown."""
+
+    lesson: Lesson
+    index: int = -1
+
+    @property
+    def step(self) -> Step | None:
+        return self.lesson.steps[self.index] if 0 <= self.index < len(self.lesson.steps) \
+            else None
+
+    def caption(self) -> str:
+        step = self.step
+        if step is None:
+            return ""
+        return f"{self.index + 1}/{len(self.lesson.steps)}  {step.title}\n{step.caption}"
