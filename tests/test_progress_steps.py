@@ -96,3 +96,21 @@ def test_mesh_file_reading_goes_through_busy(monkeypatch, tmp_path):
     mesh_module.scene_meshes(scene)
     assert any("reading 'tri.obj'" in d for d in seen)
     assert any("triangles' normals" in d for d in seen)
+
+
+def test_the_cli_shows_steps_only_on_a_terminal(monkeypatch):
+    import io
+
+    from shadelab.cli import _interactive, main
+
+    class Tty(io.StringIO):
+        def isatty(self):
+            return True
+
+    assert _interactive(Tty()) and not _interactive(io.StringIO())
+    closed = io.StringIO()
+    closed.close()
+    assert not _interactive(closed)
+    monkeypatch.setattr(progress, "SHOW_STEPS", True)
+    assert main(["presets"]) == 0                   # stderr captured by pytest: not a tty
+    assert progress.SHOW_STEPS is False

@@ -74,6 +74,13 @@ def _raised_by(exc: BaseException, kind: type) -> bool:
     return False
 
 
+def _interactive(stream) -> bool:
+    try:
+        return bool(stream.isatty())
+    except (AttributeError, ValueError):  # a closed or unusual stream
+        return False
+
+
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     parser = build_parser()
@@ -86,7 +93,9 @@ def main(argv: list[str] | None = None) -> int:
         args = parser.parse_args(argv)
         from shadelab import progress
 
-        progress.SHOW_STEPS = True   # steps over ~2 s (validation, meshes) show a bar on stderr
+        # steps over ~2 s (validation, meshes) show a bar on stderr, when a person watches it:
+        # a pipe or a log (CI, a script reading the one-line error) gets no carriage returns
+        progress.SHOW_STEPS = _interactive(sys.stderr)
         if getattr(args, "allow_large", False):
             os.environ[ALLOW_ENV] = "1"  # seen by every check, and by worker processes
         if args.command != "view" and threading.current_thread() is threading.main_thread():
