@@ -14,6 +14,7 @@ from shadelab.raytrace.surface import TraceContext
 from shadelab.raytrace.tree import trace_pixel_tree
 from shadelab.raytrace.whitted import trace_batch
 from shadelab.scene.model import Camera, Light, Material, Object, RenderSettings, Scene
+from shadelab.scene.preset import load_preset
 
 KT, OT = 0.5, (1.0, 0.5, 0.25)
 EYE = np.array([4.0, 1.0, 0.3])
@@ -108,3 +109,32 @@ def test_ray_tree_reports_the_filtered_shadow():
     assert np.abs(tree.end[[0, 2]]).max() < 1.0
     shadows = [c.shadow for c in tree.children if c.kind == "shadow"]
     assert shadows == [pytest.approx(KT * max(OT))]
+
+
+def test_one_pass_per_channel_kernel_equals_a_pass_per_channel():
+    """kernels.local_shade_into3 (S_i per channel in one pass) == three local_shade_into
+    passes with each channel's S_i, bit for bit, on random points, materials and S."""
+    from shadelab.raytrace import kernels
+
+    scene = load_preset("shadows-colored")
+    ctx = TraceContext(scene)
+    rng = np.random.default_rng(5)
+    n, lights = 500, len(ctx.lights)
+    position = rng.uniform(-2, 2, (n, 3))
+    normal = rng.normal(size=(n, 3))
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    d = rng.normal(size=(n, 3))
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    mat = rng.integers(0, len(ctx.materials), n)
+    shadow = rng.uniform(0, 1, (lights, n, 3)) * (rng.uniform(size=(lights, n, 1)) > 0.3)
+    one = np.empty((n, 3))
+    kernels.local_shade_into3(one, position, normal, d, mat, ctx.material_table,
+                              ctx.light_table, ctx.Ia, False, shadow, 1.0)
+    three = np.empty((n, 3))
+    for c in range(3):
+        part = np.empty((n, 3))
+        kernels.local_shade_into(part, position, normal, d, mat, ctx.material_table,
+                                 ctx.light_table, ctx.Ia, False,
+                                 np.ascontiguousarray(shadow[..., c]), 1.0)
+        three[:, c] = part[:, c]
+    np.testing.assert_array_equal(one, three)

@@ -132,13 +132,10 @@ def trace_batch(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarray, depth:
 
 def _shade_per_channel(ctx: TraceContext, color, position, normal, d, mat, blinn: bool,
                        shadow: np.ndarray) -> None:
-    """:func:`kernels.local_shade_into` with kt-filtered S_i (L, k, 3): a pass per channel."""
-    def shade_one(s):
-        one = ctx.workspace.get("color_c", len(mat), 3)
-        kernels.local_shade_into(one, position, normal, d, mat, ctx.material_table,
-                                 ctx.light_table, ctx.Ia, blinn, s, 1.0)
-        return one
-    ctx.local_per_channel(shade_one, shadow, color)
+    """:func:`kernels.local_shade_into` with kt-filtered S_i (L, k, 3): one pass that scales
+    each channel by its own S_i (``kernels.local_shade_into3``)."""
+    kernels.local_shade_into3(color, position, normal, d, mat, ctx.material_table,
+                              ctx.light_table, ctx.Ia, blinn, np.ascontiguousarray(shadow), 1.0)
 
 
 def _trace_batch_kernels(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarray,
