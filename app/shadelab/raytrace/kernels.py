@@ -101,74 +101,25 @@ def local_shade(position, normal, to_eye, mat, mats, lights, ia, blinn, shadow):
     return out
 
 
-@nb.njit(cache=True, parallel=True)
+@nb.njit(cache=True)
 def local_shade_into(out, position, normal, to_eye, mat, mats, lights, ia, blinn, shadow,
                      eye_sign):
     """:func:`local_shade` into ``out`` (N, 3); the vector to the eye is ``-eye_sign * to_eye``
-    (pass the ray directions with ``eye_sign = 1``, so no negated copy is made)."""
-    n_points = len(position)
-    for i in nb.prange(n_points):
-        m = mat[i]
-        px, py, pz = position[i, 0], position[i, 1], position[i, 2]
-        nx, ny, nz = normal[i, 0], normal[i, 1], normal[i, 2]
-        if eye_sign > 0.0:
-            vx, vy, vz = -to_eye[i, 0], -to_eye[i, 1], -to_eye[i, 2]
-        else:
-            vx, vy, vz = to_eye[i, 0], to_eye[i, 1], to_eye[i, 2]
-        ka, kd, ks, shininess = mats[m, M_KA], mats[m, M_KD], mats[m, M_KS], mats[m, M_N]
-        r0 = mats[m, M_LE] + ia[0] * ka * mats[m, M_OD]
-        r1 = mats[m, M_LE + 1] + ia[1] * ka * mats[m, M_OD + 1]
-        r2 = mats[m, M_LE + 2] + ia[2] * ka * mats[m, M_OD + 2]
-        for k in range(len(lights)):
-            if (kd == 0.0 and ks == 0.0) or shadow[k, i] == 0.0:
-                continue  # adds exactly 0 (mirror, glass, or a shadowed light)
-            lx, ly, lz, dist = _to_light(lights, k, px, py, pz)
-            # f_att
-            att = lights[k, L_ATT]
-            if not math.isfinite(dist) or att == _ATT_NONE:
-                f_att = 1.0
-            elif att == _ATT_INVERSE_SQUARE:
-                f_att = 1.0 / max(dist * dist, EPS)
-            else:
-                den = lights[k, L_C1] + lights[k, L_C2] * dist + lights[k, L_C3] * dist * dist
-                f_att = min(1.0 / max(den, EPS), 1.0)
-            # spot cone
-            spot = 1.0
-            if lights[k, L_KIND] == _SPOT:
-                cos_phi = -(lx * lights[k, L_DIR] + ly * lights[k, L_DIR + 1]
-                            + lz * lights[k, L_DIR + 2])
-                if cos_phi >= lights[k, L_COS]:
-                    spot = max(cos_phi, 0.0) ** lights[k, L_EXP]
-                else:
-                    spot = 0.0
-            scale = shadow[k, i] * f_att * spot
-            ndl = nx * lx + ny * ly + nz * lz
-            lam = max(ndl, 0.0)
-            spec = 0.0
-            if ndl > 0.0 and ks != 0.0:
-                if blinn:
-                    hx, hy, hz = lx + vx, ly + vy, lz + vz
-                    hl = math.sqrt(hx * hx + hy * hy + hz * hz)
-                    if hl > EPS:
-                        spec = _power((nx * hx + ny * hy + nz * hz) / hl, shininess)
-                else:
-                    rx, ry, rz = 2.0 * nx * ndl - lx, 2.0 * ny * ndl - ly, 2.0 * nz * ndl - lz
-                    spec = _power(rx * vx + ry * vy + rz * vz, shininess)
-            r0 += _lit(scale * lights[k, L_IP], kd, mats[m, M_OD], lam, ks, mats[m, M_OS], spec)
-            r1 += _lit(scale * lights[k, L_IP + 1], kd, mats[m, M_OD + 1], lam, ks,
-                       mats[m, M_OS + 1], spec)
-            r2 += _lit(scale * lights[k, L_IP + 2], kd, mats[m, M_OD + 2], lam, ks,
-                       mats[m, M_OS + 2], spec)
-        out[i, 0], out[i, 1], out[i, 2] = r0, r1, r2
+    (pass the ray directions with ``eye_sign = 1``, so no negated copy is made). ``shadow`` is
+    (L, N): :func:`local_shade_into3` with one S_i for every channel (a view, no copy)."""
+    local_shade_into3(out, position, normal, to_eye, mat, mats, lights, ia, blinn,
+                      shadow.reshape((shadow.shape[0], shadow.shape[1], 1)), eye_sign)
 
 
 @nb.njit(cache=True, parallel=True)
 def local_shade_into3(out, position, normal, to_eye, mat, mats, lights, ia, blinn, shadow,
                       eye_sign):
-    """:func:`local_shade_into` with a per-channel S_i: ``shadow`` is (L, N, 3), the
-    kt-filtered transmittance of each shadow ray. The same products in the same order as one
-    :func:`local_shade_into` pass per channel, in one pass."""
+    """The lecture's I (N, 3) into ``out`` with S_i per light and point: ``shadow`` is
+    (L, N, 3), the kt-filtered transmittance of each shadow ray per channel, or (L, N, 1), one
+    S_i for all three (:func:`local_shade_into`). The vector to the eye is
+    ``-eye_sign * to_eye``."""
     n_points = len(position)
+    w = shadow.shape[2]   # 3 channels, or 1 shared by all
     for i in nb.prange(n_points):
         m = mat[i]
         px, py, pz = position[i, 0], position[i, 1], position[i, 2]
@@ -182,7 +133,7 @@ def local_shade_into3(out, position, normal, to_eye, mat, mats, lights, ia, blin
         r1 = mats[m, M_LE + 1] + ia[1] * ka * mats[m, M_OD + 1]
         r2 = mats[m, M_LE + 2] + ia[2] * ka * mats[m, M_OD + 2]
         for k in range(len(lights)):
-            s0, s1, s2 = shadow[k, i, 0], shadow[k, i, 1], shadow[k, i, 2]
+            s0, s1, s2 = shadow[k, i, 0], shadow[k, i, 1 % w], shadow[k, i, 2 % w]
             if (kd == 0.0 and ks == 0.0) or (s0 == 0.0 and s1 == 0.0 and s2 == 0.0):
                 continue  # adds exactly 0 (mirror, glass, or a shadowed light)
             lx, ly, lz, dist = _to_light(lights, k, px, py, pz)
