@@ -246,8 +246,11 @@ def shadows_nothing(vertices: np.ndarray, face_normals: np.ndarray, light: np.nd
     side = float(light[:3] @ n - light[3] * d)        # the light's side of the plane (+/-)
     if abs(side) <= 1e-12:
         return False                                  # a light in the plane: keep it
-    for box in boxes:
-        corners = np.array([[x, y, z] for x in box[:, 0] for y in box[:, 1] for z in box[:, 2]])
-        if np.any(np.sign(side) * (corners @ n - d) < -tolerance):
-            return False
-    return True
+    if not boxes:
+        return True
+    stacked = np.stack(boxes)                                       # (M, 2, 3) min / max
+    corners = stacked[:, _CORNER_PICK, [0, 1, 2]]                   # (M, 8, 3)
+    return not bool(np.any(np.sign(side) * (corners @ n - d) < -tolerance))
+
+
+_CORNER_PICK = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)])
