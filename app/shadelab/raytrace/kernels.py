@@ -293,6 +293,68 @@ def shadow_matrix(n_lights, n, light, point, blocked):
 
 
 @nb.njit(cache=True)
+def shadow_matrix3(n_lights, n, light, point, blocked, trans):
+    """S_i (L, N, 3) of kt-filtered shadows: 1 where the point faces light i and nothing
+    blocks it, the transmittance row of each blocked ray (``trans`` holds one row per
+    blocked ray, in ray order) where something does, else 0."""
+    s = np.zeros((n_lights, n, 3))
+    b = 0
+    for j in range(len(light)):
+        k, i = light[j], point[j]
+        if blocked[j]:
+            for c in range(3):
+                s[k, i, c] = trans[b, c]
+            b += 1
+        else:
+            for c in range(3):
+                s[k, i, c] = 1.0
+    return s
+
+
+@nb.njit(cache=True)
+def gather_rays(active, o, d, left, o_out, d_out, left_out):
+    """Rows ``active`` of the shadow rays (origins, directions, distance left) into the
+    arrays passed, for the next closest-hit query."""
+    for j in range(len(active)):
+        r = active[j]
+        for c in range(3):
+            o_out[j, c] = o[r, c]
+            d_out[j, c] = d[r, c]
+        left_out[j] = left[r]
+
+
+@nb.njit(cache=True)
+def transmit_step(active, t, tri, trans, o, d, left, casts, object_index, object_material,
+                  filt, eps, next_active):
+    """One crossing of :meth:`TraceContext.shadow_transmittance` for the rays ``active`` with
+    their closest hits (``t``, ``tri`` as the accelerator gives them): a hit closer than the
+    distance left multiplies the ray's transmittance by its material's kt Ot (1 for objects
+    that cast no shadow) and restarts the ray eps past it; the rays still carrying light with
+    distance left go to ``next_active``; returns their count."""
+    count = 0
+    for j in range(len(active)):
+        r = active[j]
+        f = np.int64(tri[j])
+        if f < 0:
+            continue
+        tj = np.float64(t[j])
+        if not tj < left[r]:
+            continue
+        if casts[f]:
+            m = object_material[object_index[f]]
+            for c in range(3):
+                trans[r, c] *= filt[m, c]
+        step = tj + eps
+        for c in range(3):
+            o[r, c] += step * d[r, c]
+        left[r] -= step
+        if max(trans[r, 0], max(trans[r, 1], trans[r, 2])) > 0.0 and left[r] > 0.0:
+            next_active[count] = r
+            count += 1
+    return count
+
+
+@nb.njit(cache=True)
 def add_misses(out, pixel, weight, tri, background):
     """out[pixel[i]] += weight[i] * background where the ray missed (``tri`` < 0)."""
     for i in range(len(pixel)):

@@ -224,30 +224,38 @@ class TraceContext:
         g = self.geometry
         m = len(origins)
         trans = np.ones((m, 3))
-        filt = self.kt[:, None] * self.tint  # (materials, 3), 0 for the opaque ones
+        if g.count == 0:
+            return trans
         o = np.array(origins, dtype=np.float64).reshape(m, 3)
         d = np.ascontiguousarray(dirs, dtype=np.float64).reshape(m, 3)
         left = np.array(np.broadcast_to(tmax, (m,)), dtype=np.float64)
         active = np.arange(m)
+        ws = self.workspace
+        # Each crossing: one closest-hit query of the rays still carrying light, and one
+        # kernel (kernels.transmit_step) for the filter and the restart, in place
         for _ in range(MAX_SHADOW_CROSSINGS):
-            if len(active) == 0:
+            k = len(active)
+            if k == 0:
                 return trans
-            hits = self.accel.intersect(o[active], d[active], left[active])
-            self.shadow_rays += len(active)
-            hit = (hits.tri >= 0) & (hits.t < left[active])
-            rows, t, tri = active[hit], hits.t[hit], hits.tri[hit]
-            material = self.object_material[g.object_index[tri]]
-            factor = np.where(g.casts_shadow[tri][:, None], filt[material], 1.0)
-            trans[rows] *= factor
-            step = t + self.eps
-            o[rows] += step[:, None] * d[rows]
-            left[rows] -= step
-            active = rows[(trans[rows].max(axis=1) > 0.0) & (left[rows] > 0.0)]
+            og, dg, lg = ws.get("tr_o", k, 3), ws.get("tr_d", k, 3), ws.get("tr_left", k)
+            kernels.gather_rays(active, o, d, left, og, dg, lg)
+            t, tri, _, _ = self.accel.intersect_raw(og, dg, lg)
+            self.shadow_rays += k
+            following = ws.get("tr_active", k, 0, np.int64)
+            count = kernels.transmit_step(active, t, tri, trans, o, d, left, g.casts_shadow,
+                                          g.object_index, self.object_material,
+                                          self._shadow_filter, self.eps, following)
+            active = following[:count].copy()
         if len(active):
             blocked = self.accel.occluded(o[active], d[active], left[active])
             self.shadow_rays += len(active)
             trans[active[blocked]] = 0.0
         return trans
+
+    @cached_property
+    def _shadow_filter(self) -> np.ndarray:
+        """(materials, 3) kt Ot per material (0 for the opaque ones)."""
+        return np.ascontiguousarray(self.kt[:, None] * self.tint)
 
     def _filter_blocked(self, s: np.ndarray, idx: np.ndarray, blocked: np.ndarray,
                         origins: np.ndarray, dirs: np.ndarray, tmax: np.ndarray) -> np.ndarray:
@@ -261,17 +269,17 @@ class TraceContext:
             s3[idx[rows]] = self.shadow_transmittance(origins[rows], dirs[rows], tmax[rows])
         return s3
 
-    def filtered_shadow_matrix(self, shadow: np.ndarray, light: np.ndarray, point: np.ndarray,
-                               blocked: np.ndarray, origins: np.ndarray, dirs: np.ndarray,
-                               tmax: np.ndarray) -> np.ndarray:
-        """The Whitted kernels' S (L, N) made (L, N, 3): each blocked shadow ray j (to light
-        ``light[j]`` from point ``point[j]``) gets its :meth:`shadow_transmittance`."""
-        s3 = np.repeat(shadow[:, :, None], 3, axis=2)
+    def filtered_shadow_matrix(self, shape: tuple[int, int], light: np.ndarray,
+                               point: np.ndarray, blocked: np.ndarray, origins: np.ndarray,
+                               dirs: np.ndarray, tmax: np.ndarray) -> np.ndarray:
+        """The Whitted kernels' S (L, N, 3) for ``shape`` (L, N) from their shadow rays j (to
+        light ``light[j]`` from point ``point[j]``): 1 where unblocked, the ray's
+        :meth:`shadow_transmittance` where blocked, 0 for the pairs with no ray (facing away)."""
         rows = np.flatnonzero(blocked)
-        if len(rows):
-            s3[light[rows], point[rows]] = self.shadow_transmittance(
-                origins[rows], dirs[rows], tmax[rows])
-        return s3
+        trans = (self.shadow_transmittance(origins[rows], dirs[rows], tmax[rows]) if len(rows)
+                 else np.zeros((0, 3)))
+        return kernels.shadow_matrix3(shape[0], shape[1], light, point,
+                                      np.ascontiguousarray(blocked, dtype=np.bool_), trans)
 
     def local_per_channel(self, shade_one, shadow3: np.ndarray, out: np.ndarray) -> np.ndarray:
         """The lecture's equation with a per-channel S_i: channel c of ``out`` is channel c

@@ -192,11 +192,13 @@ def _trace_batch_kernels(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarra
             blocked = ctx.accel.occluded(o32[:count], d32[:count], t32[:count])
             stats.shadow += count
             ctx.shadow_rays += count
-            shadow = kernels.shadow_matrix(n_lights, k, light[:count], point[:count], blocked)
             if ctx.transparent_casters:  # kt-filtered S_i (L, k, 3)
-                shadow = ctx.filtered_shadow_matrix(shadow, light[:count], point[:count],
-                                                    blocked, o32[:count], d32[:count],
-                                                    t32[:count])
+                shadow = ctx.filtered_shadow_matrix((n_lights, k), light[:count],
+                                                    point[:count], blocked, o32[:count],
+                                                    d32[:count], t32[:count])
+            else:
+                shadow = kernels.shadow_matrix(n_lights, k, light[:count], point[:count],
+                                               blocked)
         else:
             shadow = np.zeros((0, k))
         color = ws.get("color", k, 3)
