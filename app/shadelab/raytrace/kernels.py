@@ -293,11 +293,11 @@ def shadow_matrix(n_lights, n, light, point, blocked):
 
 
 @nb.njit(cache=True)
-def shadow_matrix3(n_lights, n, light, point, blocked, trans):
-    """S_i (L, N, 3) of kt-filtered shadows: 1 where the point faces light i and nothing
-    blocks it, the transmittance row of each blocked ray (``trans`` holds one row per
+def shadow_matrix3(s, light, point, blocked, trans):
+    """S_i (L, N, 3) of kt-filtered shadows, into ``s``: 1 where the point faces light i and
+    nothing blocks it, the transmittance row of each blocked ray (``trans`` holds one row per
     blocked ray, in ray order) where something does, else 0."""
-    s = np.zeros((n_lights, n, 3))
+    s[:] = 0.0
     b = 0
     for j in range(len(light)):
         k, i = light[j], point[j]
@@ -308,7 +308,6 @@ def shadow_matrix3(n_lights, n, light, point, blocked, trans):
         else:
             for c in range(3):
                 s[k, i, c] = 1.0
-    return s
 
 
 @nb.njit(cache=True)
@@ -649,13 +648,13 @@ def camera_rays(eye, forward, right, up, tan_half, width, height, r0, r1, jitter
     return origins, dirs
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, parallel=True)
 def camera_rays_into(origins, dirs, eye, forward, right, up, tan_half, width, height, r0, r1,
                      jitter):
     """:func:`camera_rays` into the arrays passed ((r1 - r0) width rows each)."""
     aspect = width / height
     centre = jitter.shape[0] == 0
-    for j in range(r0, r1):
+    for j in nb.prange(r0, r1):
         for i in range(width):
             k = (j - r0) * width + i
             jx = 0.5 if centre else jitter[j - r0, i, 0]

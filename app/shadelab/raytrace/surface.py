@@ -274,12 +274,16 @@ class TraceContext:
                                dirs: np.ndarray, tmax: np.ndarray) -> np.ndarray:
         """The Whitted kernels' S (L, N, 3) for ``shape`` (L, N) from their shadow rays j (to
         light ``light[j]`` from point ``point[j]``): 1 where unblocked, the ray's
-        :meth:`shadow_transmittance` where blocked, 0 for the pairs with no ray (facing away)."""
+        :meth:`shadow_transmittance` where blocked, 0 for the pairs with no ray (facing away).
+        The array is the workspace's, valid until the next call."""
         rows = np.flatnonzero(blocked)
         trans = (self.shadow_transmittance(origins[rows], dirs[rows], tmax[rows]) if len(rows)
                  else np.zeros((0, 3)))
-        return kernels.shadow_matrix3(shape[0], shape[1], light, point,
-                                      np.ascontiguousarray(blocked, dtype=np.bool_), trans)
+        n_lights, n = shape
+        s = self.workspace.get("shadow3", n_lights * n * 3).reshape(n_lights, n, 3)
+        kernels.shadow_matrix3(s, light, point, np.ascontiguousarray(blocked, dtype=np.bool_),
+                               trans)
+        return s
 
     def local_per_channel(self, shade_one, shadow3: np.ndarray, out: np.ndarray) -> np.ndarray:
         """The lecture's equation with a per-channel S_i: channel c of ``out`` is channel c
