@@ -69,3 +69,33 @@ def run_scenario_main(scenarios: dict, name: str, out_dir: str, preset: str = "c
     run_viewer(state, ViewerOptions(window_size=window_size, test_function=body, **options))
     Path(out_dir, f"{name}.json").write_text(json.dumps(out))
     return 0
+
+
+GL_MODULES = ("moderngl", "OpenGL", "glfw", "shadelab.gl", "shadelab.render",
+              "shadelab.ui.viewport", "shadelab.ui.gpu_side")
+
+
+def gl_objects_in(state) -> list[str]:
+    """Where a GL object hangs in the state the panels see: the AppState's fields (and the
+    Hemicube window's view of it), walked through dataclasses, dicts, lists and the
+    attributes of shadelab objects; ``[]`` when the state is plain data."""
+    from shadelab.ui import radiosity_view
+
+    found, seen = [], set()
+    todo = [("state", state), ("radiosity_view", radiosity_view._views.get(id(state)))]
+    while todo:
+        path, obj = todo.pop()
+        if obj is None or id(obj) in seen or isinstance(obj, (str, bytes, int, float, bool)):
+            continue
+        seen.add(id(obj))
+        module = type(obj).__module__ or ""
+        if any(module == m or module.startswith(m + ".") for m in GL_MODULES):
+            found.append(f"{path}: {module}.{type(obj).__name__}")
+            continue
+        if isinstance(obj, dict):
+            todo += [(f"{path}[{k!r}]", v) for k, v in obj.items()]
+        elif isinstance(obj, (list, tuple, set)):
+            todo += [(f"{path}[{i}]", v) for i, v in enumerate(obj)]
+        elif module.startswith("shadelab.") and hasattr(obj, "__dict__"):
+            todo += [(f"{path}.{k}", v) for k, v in vars(obj).items()]
+    return sorted(found)

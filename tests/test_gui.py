@@ -141,6 +141,13 @@ def _probe_at(ctx, state, pixel) -> None:
     _wait(ctx, lambda: state.probe is not None and not state.probe_requested)
 
 
+def _gl_side():
+    """The running viewer's Viewport (GL internals; the state holds no GL object)."""
+    from shadelab.ui.app import running_viewer
+
+    return running_viewer().viewport
+
+
 def _centre(state) -> tuple[int, int]:
     w, h = state.viewport_size
     return w // 2, h // 2
@@ -150,8 +157,8 @@ def scenario_kd_slider(ctx, state, out: dict) -> None:
     ctx.yield_(3)
     _probe_at(ctx, state, _centre(state))  # the back wall: Cornell white
     out["gpu_before"] = state.probe.gpu.tolist()
-    out["uploads_before"] = len(state.gl.renderer._gpu)
-    keys_before = [g.key for g in state.gl.renderer._gpu.values()]
+    out["uploads_before"] = len(_gl_side().renderer._gpu)
+    keys_before = [g.key for g in _gl_side().renderer._gpu.values()]
     ctx.set_ref("//Materials")
     ctx.window_focus("//Materials")
     ctx.item_input_value("material_white/white/kd", 0.5)
@@ -160,8 +167,8 @@ def scenario_kd_slider(ctx, state, out: dict) -> None:
     out["kd_after"] = state.scene.materials["white"].kd
     out["gpu_after"] = state.probe.gpu.tolist()
     out["reference_after"] = state.probe.reference.tolist()
-    out["uploads_after"] = len(state.gl.renderer._gpu)
-    assert keys_before == [g.key for g in state.gl.renderer._gpu.values()]
+    out["uploads_after"] = len(_gl_side().renderer._gpu)
+    assert keys_before == [g.key for g in _gl_side().renderer._gpu.values()]
     ctx.key_press(imgui_key("mod_ctrl") | imgui_key("z"))
     ctx.yield_(2)
     out["undo_kd"] = state.scene.materials["white"].kd
@@ -336,7 +343,7 @@ def scenario_smoke(ctx, state, out: dict) -> None:
     _probe_at(ctx, state, (state.viewport_size[0] // 2, int(state.viewport_size[1] * 0.85)))
     out["spot_gpu"], out["spot_reference"] = state.probe.gpu.tolist(), \
         state.probe.reference.tolist()
-    keys = {i: g.key for i, g in state.gl.renderer._gpu.items()}
+    keys = {i: g.key for i, g in _gl_side().renderer._gpu.items()}
     ctx.window_focus("//Objects")
     ctx.yield_(3)
     ctx.set_ref("//Objects")
@@ -344,7 +351,7 @@ def scenario_smoke(ctx, state, out: dict) -> None:
     ctx.item_input_value("object0/###obj/tessellation (segments)", 4)
     ctx.yield_(3)
     out["segments"] = state.scene.objects[0].segments
-    out["uploaded_keys_changed"] = [i for i, g in state.gl.renderer._gpu.items()
+    out["uploaded_keys_changed"] = [i for i, g in _gl_side().renderer._gpu.items()
                                     if keys.get(i) != g.key]
     toggles = {"compare": "c", "diff_enabled": "d", "show_wireframe": "w",
                "show_normals": "n", "presenter": "f", "show_help": "h"}

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from gui_harness import run_scenario_main  # noqa: E402
+from gui_harness import gl_objects_in, run_scenario_main  # noqa: E402
 from test_gui import _probe_at, _wait, run_scenario  # noqa: E402
 from test_gui import xdisplay as _xdisplay_fixture  # noqa: E402
 
@@ -63,6 +63,7 @@ def test_hemicube_window_shows_the_patch_and_F_while_the_frame_keeps_coming(xdis
     assert r["total"] == pytest.approx(sum(r["face_sums"].values()), abs=1e-12)
     assert r["frames"] >= r["batches"]           # one batch of rows per frame, UI drawn
     assert r["textures"] == [[256, 256], [256, 256]]   # the 2 res cross, res 128
+    assert r["gl_objects_in_state"] == []        # the GL side keeps the hemicube and textures
     assert r["follow_shooter"] == r["shooter"]   # the radiosity pipeline's shooting patch
     assert r["patch_id_soup"] == [6 * r["n"], 6]
 
@@ -124,19 +125,20 @@ def scenario_hemicube_window(ctx, state, out: dict) -> None:
     ctx.yield_(3)
     ctx.set_ref("//Hemicube & F")
     view = rv.view_of(state)
-    assert _wait(ctx, lambda: view.cube is not None and view.rows_done >= len(view.patches),
+    assert _wait(ctx, lambda: view.patches is not None and view.rows_done >= len(view.patches),
                  600), view.error
     out["frames"] = state.frame - frame0
     out["n"] = n = len(view.patches)
-    out["batches"] = -(-n // view.cube.batch)
+    out["batches"] = -(-n // view.batch)
     ctx.item_input_value("patch", 20)
-    ctx.yield_(3)
+    assert _wait(ctx, lambda: view.shown == (view.key, 20), 60), view.error
     out["patch"] = view.patch
     hv = view.views[view.patch]
     out["total"], out["face_sums"] = hv["total"], hv["face_sums"]
     out["row_sums"] = view.F.sum(axis=1).tolist()
     np.save(Path(OUT_DIR) / "F.npy", view.F)
-    out["textures"] = [list(state.gl.images[k].size) for k in ("hemicube_ids", "hemicube_dF")]
+    out["textures"] = [list(state.gpu.texture(k).size) for k in ("hemicube_ids", "hemicube_dF")]
+    out["gl_objects_in_state"] = gl_objects_in(state)
     from imgui_bundle import imgui
     from imgui_bundle.immapp import testing
 

@@ -122,7 +122,9 @@ def scenario_translate(ctx, state, out: dict) -> None:
     state.commit_edit()
     ctx.yield_(2)
     before = _mask_stats(_viewport_image(ctx, state, "before"))
-    height = state.gl.panes["main"].size[1]
+    from shadelab.ui.app import running_viewer
+
+    height = running_viewer().viewport.panes["main"].size[1]
     out["pixel_size"] = gizmos.pixel_size_at(state, (0.0, 0.0, 0.0), height)
     ctx.window_focus("//Objects")
     ctx.set_ref("//Objects")

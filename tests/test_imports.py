@@ -110,3 +110,81 @@ def test_cycle_finder_reports_a_cycle():
     graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}
     assert find_cycle(graph) == ["a", "b", "c", "a"]
     assert find_cycle({"a": {"b"}, "b": set()}) is None
+
+
+# ---------------------------------------------------------------- the UI: panels vs GL side
+
+GL = ("moderngl", "OpenGL", f"{PACKAGE}.gl", f"{PACKAGE}.render")
+# The viewer's GL side: the shell that owns the window, the viewport's passes, the queue's
+# server and the pipelines' viewport drawing. Every other ui module (panels, state, jobs...)
+# reaches the GPU only through ``state.gpu`` (shadelab.ui.gpu_queue).
+GL_SIDE = tuple(f"{PACKAGE}.ui.{m}" for m in ("app", "viewport", "gpu_side", "pipeline_viewport"))
+
+
+def test_panels_import_no_gl_module():
+    """No ui module but the GL side imports moderngl, OpenGL, shadelab.gl, shadelab.render or
+    the GL side itself, not even lazily inside a function."""
+    bad = []
+    for name, path in modules().items():
+        if not is_under(name, f"{PACKAGE}.ui") or name in GL_SIDE:
+            continue
+        for target, _, line in imported(name, path):
+            if any(is_under(target, g) for g in GL + GL_SIDE[1:]):
+                bad.append(f"{path.relative_to(ROOT)}:{line}: imports {target}")
+    assert not bad, "a panel module imports GL:\n" + "\n".join(sorted(set(bad)))
+
+
+def _field_types(cls) -> dict[str, object]:
+    """``typing.get_type_hints`` of a dataclass, its ``if TYPE_CHECKING:`` imports included."""
+    import importlib
+    import typing
+
+    module = importlib.import_module(cls.__module__)
+    namespace = dict(vars(module))
+    tree = ast.parse(Path(module.__file__).read_text(encoding="utf-8"))
+    for node in ast.walk(tree):
+        if isinstance(node, ast.If) and getattr(node.test, "id", "") == "TYPE_CHECKING":
+            exec(compile(ast.Module(node.body, []), module.__file__, "exec"), namespace)
+    return typing.get_type_hints(cls, globalns=namespace)
+
+
+def _classes_in(hint) -> list[type]:
+    import typing
+
+    out, todo = [], [hint]
+    while todo:
+        h = todo.pop()
+        todo += list(typing.get_args(h))
+        if isinstance(h, type):
+            out.append(h)
+    return out
+
+
+def test_app_state_holds_no_gl_object():
+    """AppState, its sub-states and what the panels queue for the GPU: no ``gl`` field and no
+    field whose type is a GL object (a moderngl, shadelab.gl, shadelab.render or GL-side
+    class)."""
+    from shadelab.ui.gpu_queue import GpuQueue, Request, Texture
+    from shadelab.ui.pipeline_view import PipelineView
+    from shadelab.ui.radiosity_view import RadiosityView
+    from shadelab.ui.state import SUB_STATES, AppState
+
+    bad = []
+    for cls in (AppState, *SUB_STATES.values(), GpuQueue, Request, Texture, PipelineView,
+                RadiosityView):
+        for name, hint in _field_types(cls).items():
+            if name == "gl":
+                bad.append(f"{cls.__name__}.gl")
+            for t in _classes_in(hint):
+                if any(is_under(t.__module__, g) for g in GL + GL_SIDE):
+                    bad.append(f"{cls.__name__}.{name}: {t.__module__}.{t.__name__}")
+    assert not bad, "GL in the panels' state:\n" + "\n".join(bad)
+
+
+def test_gl_type_finder_sees_a_gl_class_inside_a_hint():
+    """The check above can fail: a Viewport inside an optional or a dict is found."""
+    from shadelab.ui.viewport import Viewport
+
+    assert Viewport in _classes_in(Viewport | None)
+    assert Viewport in _classes_in(dict[str, list[Viewport]])
+    assert not any(is_under(t.__module__, "shadelab") for t in _classes_in(dict[str, int]))

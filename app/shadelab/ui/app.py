@@ -23,6 +23,7 @@ from shadelab.ui import (
     lesson,
     overlays,
     panels,
+    pipeline_viewport,
     pipelines,
     presenter,
     radiosity_view,
@@ -144,6 +145,7 @@ class Viewer:
     state: AppState
     options: ViewerOptions
     viewport: object = None            # shadelab.ui.viewport.Viewport, made in post_init
+    gpu: object = None                 # shadelab.ui.gpu_side.GpuSide: serves state.gpu
     drag: float = 0.0                  # pixels moved since the mouse went down
     last_autosave: float = 0.0
     title: str = ""
@@ -159,10 +161,12 @@ class Viewer:
     # ------------------------------------------------------------ GL lifetime
     def post_init(self) -> None:
         from shadelab.gl.context import attach_to_current
+        from shadelab.ui.gpu_side import GpuSide
         from shadelab.ui.viewport import Viewport
 
         self.viewport = Viewport(attach_to_current())
-        self.state.gl = self.viewport
+        self.gpu = GpuSide(self.viewport)
+        self.gpu.flush(self.state.gpu)  # attached: panels may queue work from the first frame
         from shadelab.gl.target import max_msaa_samples
 
         self.state.msaa_limit = max_msaa_samples(self.viewport.ctx)
@@ -183,6 +187,9 @@ class Viewer:
         if self.options.bench_json:
             self.recorder.write(self.options.bench_json, self.options.window_size,
                                 pipelines.bench_report(self.state))  # jobs: first_image_s...
+        if self.gpu is not None:
+            self.gpu.release()
+            self.gpu = None
         if self.viewport is not None:
             self.viewport.release()
             self.viewport = None
@@ -263,7 +270,7 @@ class Viewer:
     def draw_main(self, size: tuple[int, int]) -> None:
         state, vp = self.state, self.viewport
         scene = state.scene
-        if pipelines.draw(self, size):  # an offline pipeline or the wipe took the viewport
+        if pipeline_viewport.draw(self, size):  # an offline pipeline or the wipe took the viewport
             return
         display_size, size = size, self.render_size(size)
         if "main" in vp.panes and self.unchanged(size):
@@ -453,6 +460,12 @@ class Viewer:
             self.state.error = f"screenshot '{path}': cannot write ({exc})"
 
     # ------------------------------------------------------------ per frame
+    def begin_frame(self) -> None:
+        """Before any panel draws: the GPU work and images the panels queued last frame."""
+        if self.gpu is not None:
+            guarded(lambda: self.gpu.flush(self.state.gpu), "GPU requests", self.report_error)
+        gizmos.begin_frame()
+
     def panel(self, draw: Callable[[AppState], bool]) -> Callable[[], None]:
         where = draw.__name__.removeprefix("draw_").removesuffix("_panel").strip("_") + " panel"
 
@@ -619,15 +632,31 @@ def runner_params(viewer: Viewer) -> hello_imgui.RunnerParams:
                                            or viewer.options.frames)
     params.callbacks.post_init = viewer.post_init
     params.callbacks.before_exit = viewer.before_exit
-    params.callbacks.post_new_frame = gizmos.begin_frame
+    params.callbacks.post_new_frame = viewer.begin_frame
     params.callbacks.after_swap = viewer.frame_swapped
     params.callbacks.show_gui = lambda: guarded(viewer.end_frame, "frame", viewer.report_error)
     return params
 
 
+_running: list[Viewer] = []  # the viewer of this process's window while it runs
+
+
+def running_viewer() -> Viewer | None:
+    """The viewer whose window is open (GUI tests reach its GL side here; panels never)."""
+    return _running[-1] if _running else None
+
+
 def run_viewer(state: AppState, options: ViewerOptions) -> int:
     """Open the window and run until it is closed (or ``options.frames`` frames)."""
     viewer = Viewer(state, options)
+    _running.append(viewer)
+    try:
+        return _run(viewer, state, options)
+    finally:
+        _running.remove(viewer)
+
+
+def _run(viewer: Viewer, state: AppState, options: ViewerOptions) -> int:
     if options.test_function is None:
         state.pipeline = options.pipeline or state.pipeline
         if state.pipeline in pipelines.OFFLINE:

@@ -59,10 +59,10 @@ def start_job(state: AppState, index: int) -> None:
     if kind.label.startswith("Path"):
         scene.raytrace.spp = state.job_spp
     size = _job_size(state)
-    if state.gl is not None:
-        state.gl.draw_scene("job_raster", scene, size, kind.raster_shading, scene.render.specular)
-        state.job_raster = state.gl.read_linear("job_raster")
-        state.gl.restore()
+    # the raster view to compare with: drawn by the GL side before the panels' next frame
+    state.gpu.request("job_raster", "raster", scene=scene, size=size,
+                      shading=kind.raster_shading, specular=scene.render.specular)
+    state.job_raster = None
     state.job_kind, state.job_version, state.job_compare = index, -1, None
     state.job_scene, state.job_size_px = scene, size
     state.ray_tree = state.ray_tree_pixel = None
@@ -87,6 +87,9 @@ def _job_size(state: AppState) -> tuple[int, int]:
 
 def _upload_results(state: AppState) -> None:
     """Re-upload the job's image, its raster partner and their difference when new."""
+    raster = state.gpu.take("job_raster")
+    if raster is not None:     # (the job's image, if already here, is compared again)
+        state.job_raster, state.job_version = raster, -1
     latest, version = state.job.snapshot()
     if latest is None or version == state.job_version:
         return
@@ -96,13 +99,13 @@ def _upload_results(state: AppState) -> None:
         return
     exposure = state.scene.render.exposure
     image = np.asarray(latest.image, dtype=np.float32)
-    vp = state.gl
-    vp.upload_image("job_result", to_srgb8(image, exposure))
+    gpu = state.gpu
+    gpu.upload("job_result", to_srgb8(image, exposure))
     raster = state.job_raster
     if raster is not None and raster.shape == image.shape:
-        vp.upload_image("job_raster", to_srgb8(raster, exposure))
+        gpu.upload("job_raster", to_srgb8(raster, exposure))
         scale = max(float(np.abs(raster).max()) * exposure, 1e-6) * 0.1
-        vp.upload_image("job_diff", heat_map(image * exposure, raster * exposure, scale))
+        gpu.upload("job_diff", heat_map(image * exposure, raster * exposure, scale))
         state.job_compare = difference(image, raster) | {"heat_full_scale": scale / exposure}
         if not state.job.running:  # FLIP (~0.1 s at 128^2): once, on the final image
             from shadelab.studies.metrics import flip
@@ -122,13 +125,13 @@ def _take_solution(state: AppState, latest) -> None:
 
 def _show(state: AppState, key: str, caption: str, width: float) -> tuple[int, int] | None:
     """Show an uploaded image; returns the image pixel clicked, if any."""
-    tex = state.gl.images.get(key)
+    tex = state.gpu.texture(key)
     if tex is None:
         return None
     w, h = tex.size
     imgui.begin_group()
     origin = imgui.get_cursor_screen_pos()
-    imgui.image(imgui.ImTextureRef(tex.glo), imgui.ImVec2(width, width * h / w))
+    imgui.image(imgui.ImTextureRef(tex.id), imgui.ImVec2(width, width * h / w))
     clicked = None
     if imgui.is_item_clicked():
         mouse = imgui.get_io().mouse_pos
@@ -256,11 +259,13 @@ def draw_offline_panel(state: AppState) -> bool:
         imgui.push_text_wrap_pos(0.0)
         imgui.text_colored(panels.ERROR_COLOR, job.error)
         imgui.pop_text_wrap_pos()
-    if state.gl is None:
+    if not state.gpu.attached:
         return False
     _upload_results(state)
+    if "job_raster" in state.gpu.errors:
+        state.error = f"raster view to compare with: {state.gpu.errors.pop('job_raster')}"
     width = (imgui.get_content_region_avail().x - 16) / 3
-    if "job_result" in state.gl.images and width > 8:
+    if state.gpu.texture("job_result") is not None and width > 8:
         clicked = _show(state, "job_result", "offline (click: ray tree)"
                         if kind.label.startswith("Whitted") else "offline", width)
         if clicked is not None and kind.label.startswith("Whitted") and not job.running:

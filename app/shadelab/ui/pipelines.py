@@ -22,7 +22,7 @@ import numpy as np
 from imgui_bundle import imgui
 
 from shadelab.scene.preset import clone_scene
-from shadelab.ui import pipeline_jobs, radiosity_view
+from shadelab.ui import pipeline_jobs
 from shadelab.ui.pipeline_view import PipelineView
 from shadelab.ui.state import AppState
 
@@ -207,12 +207,12 @@ def _take(state: AppState) -> None:
     if "history" in stats:
         view.history = stats["history"]
     got_image = False
-    if latest.image is not None and state.gl is not None:
+    if latest.image is not None:
         from shadelab.shading.conventions import to_srgb8
 
         image = np.asarray(latest.image, np.float32)
         srgb = to_srgb8(image, state.scene.render.exposure)
-        state.gl.upload_image("pipeline", np.ascontiguousarray(srgb[::-1]))  # bottom-up
+        state.gpu.upload("pipeline", srgb[::-1])  # bottom-up
         view.image_size = (image.shape[1], image.shape[0])
         view.linear = image
         got_image = True
@@ -291,111 +291,6 @@ def bench_report(state: AppState) -> dict:
 # ---------------------------------------------------------------- drawing
 
 
-def draw(viewer, display_size: tuple[int, int]) -> bool:
-    """The main viewport in an offline pipeline or with the wipe; False: the raster path."""
-    state = viewer.state
-    view = view_of(state)
-    sync(state)
-    track_side_panel_job(state)
-    name = current(state)
-    wipe = state.wipe and state.wipe_pipeline in PIPELINES and state.wipe_pipeline != name
-    if name not in OFFLINE and not wipe:
-        if view.runner is not None and view.runner.running and view.name in OFFLINE:
-            view.runner.cancel()
-        view.key = None
-        return False
-    scale = state.render_scale
-    size = (max(int(display_size[0] * scale), 8), max(int(display_size[1] * scale), 8))
-    if state.frame < 3:     # the dock layout settles over the first frames: no job at 16x16
-        return True
-    other = state.wipe_pipeline if wipe else None
-    offline = [n for n in (name, other) if n in OFFLINE]
-    if offline:
-        poll(state, offline[0], size)
-        if view.runner.running:
-            view.frame_times.append(time.perf_counter())
-    elif view.runner is not None and view.runner.running and view.name in OFFLINE:
-        view.runner.cancel()
-        view.key = None
-    tex_a = _texture(viewer, name, size, offline)
-    origin = imgui.get_cursor_screen_pos()
-    clicked = viewer._image_with_input(tex_a, display_size) if tex_a is not None else None
-    draw_list = imgui.get_window_draw_list()
-    if tex_a is None:
-        imgui.set_cursor_screen_pos(origin)
-        clicked = viewer._image_with_input(_blank(viewer), display_size)
-    if wipe:
-        tex_b = _texture(viewer, other, size, offline)
-        x = origin.x + state.wipe_position * display_size[0]
-        if tex_b is not None:
-            draw_list.add_image(imgui.ImTextureRef(tex_b.glo), imgui.ImVec2(x, origin.y),
-                                imgui.ImVec2(origin.x + display_size[0],
-                                             origin.y + display_size[1]),
-                                imgui.ImVec2(state.wipe_position, _v(other, 0)),
-                                imgui.ImVec2(1.0, _v(other, 1)))
-        draw_list.add_line(imgui.ImVec2(x, origin.y), imgui.ImVec2(x, origin.y + display_size[1]),
-                           0xFFFFFFFF, 3.0)
-        _label(draw_list, imgui.ImVec2(origin.x + 8, origin.y + display_size[1] - 28),
-               LABELS[name])
-        _label(draw_list, imgui.ImVec2(x + 8, origin.y + display_size[1] - 28), LABELS[other])
-    if name == "raytrace" and view.ray_tree is not None:
-        draw_ray_tree(state, draw_list, origin, display_size)
-    _label(draw_list, imgui.ImVec2(origin.x + 8, origin.y + 8), status_line(state))
-    if clicked is not None:
-        _clicked(state, name, clicked, display_size)
-    if state.screenshot_requested:
-        _screenshot_pipeline(viewer, tex_a)
-    return True
-
-
-def _v(name: str, end: int) -> float:
-    """The texture's v at the top (end 0) / bottom (1): GL panes are bottom-up, and the
-    offline images are uploaded bottom-up too, so one image call shows them all."""
-    return 1.0 - end
-
-
-def _blank(viewer):
-    vp = viewer.viewport
-    if "pipeline_blank" not in vp.images:
-        vp.upload_image("pipeline_blank", np.zeros((8, 8, 3), np.uint8))
-    return vp.images["pipeline_blank"]
-
-
-def _texture(viewer, name: str, size: tuple[int, int], offline: list):
-    """The display texture of pipeline ``name`` (raster: rendered now if its inputs changed)."""
-    state, vp = viewer.state, viewer.viewport
-    view = view_of(state)
-    exposure = state.scene.render.exposure
-    if name in ("raytrace", "pathtrace"):
-        if offline and offline[0] != name:
-            return None
-        if view.name != name and view.version < 0:
-            return None
-        return vp.images.get("pipeline")
-    if name == "radiosity":
-        if view.soup is None or view.name != "radiosity":
-            return None
-        pane = vp.pane("pipeline_radiosity", size)
-        vp.draw_colored_triangles(pane, state.scene, radiosity_view.viewport_soup(state, view.soup))
-        if state.show_wireframe or state.radiosity_patches:
-            vp.draw_lines(pane, patch_edges(view.soup), exposure)
-        if view.shooter is not None and not view.stats.get("done"):
-            vp.draw_lines(pane, shooter_lines(view.shooter), exposure, depth_test=False)
-        return vp.present(pane, exposure)
-    shading, visibility = RASTER[name]
-    key = (repr(state.scene), size, name)
-    pane_key = f"pipeline_{name}"
-    if view.raster_key.get(name) != key or pane_key not in vp.panes:
-        view.raster_key[name] = key
-        scene = state.scene
-        if (scene.render.shading, scene.render.visibility) != (shading, visibility):
-            scene = clone_scene(scene)
-            scene.render.shading, scene.render.visibility = shading, visibility
-        pane = vp.draw_scene(pane_key, scene, size, shading, scene.render.specular)
-        vp.present(pane, exposure)
-    return vp.panes[pane_key].display
-
-
 def patch_edges(soup: np.ndarray) -> np.ndarray:
     """Each display triangle's edges (the patches: two triangles per quad patch, the
     diagonal included) as dark segments."""
@@ -418,7 +313,7 @@ def shooter_lines(polygon: np.ndarray) -> np.ndarray:
     return out.reshape(-1, 6)
 
 
-def _label(draw_list, pos, text: str) -> None:
+def label(draw_list, pos, text: str) -> None:
     size = imgui.calc_text_size(text)
     draw_list.add_rect_filled(imgui.ImVec2(pos.x - 4, pos.y - 2),
                               imgui.ImVec2(pos.x + size.x + 4, pos.y + size.y + 2), 0xB0000000)
@@ -440,7 +335,7 @@ def status_line(state: AppState) -> str:
     return f"{LABELS[name]}: {word}  {view.message}  {elapsed:.1f} s"
 
 
-def _clicked(state: AppState, name: str, pixel, display_size) -> None:
+def pick_ray_tree(state: AppState, name: str, pixel, display_size) -> None:
     """A click in the ray-traced viewport picks that pixel's ray tree."""
     view = view_of(state)
     if name != "raytrace" or view.job_scene is None:
@@ -514,23 +409,5 @@ def draw_ray_tree(state: AppState, draw_list, origin, display_size) -> None:
             draw_list.add_line(a, b, RAY_COLORS[kind], thick)
         if node.end is not None and node.kind != "shadow":
             draw_list.add_circle_filled(b, thick + 2, RAY_COLORS[kind])
-            _label(draw_list, imgui.ImVec2(b.x + 8, b.y - 8),
+            label(draw_list, imgui.ImVec2(b.x + 8, b.y - 8),
                    f"{node.kind} d{node.depth}: {object_label(scene, node.object)}")
-
-
-def _screenshot_pipeline(viewer, texture) -> None:
-    """The S key in an offline pipeline: the pipeline's image as a PNG."""
-    from PIL import Image
-
-    state = viewer.state
-    path, state.screenshot_requested = state.screenshot_requested, ""
-    if texture is None:
-        state.error = f"screenshot '{path}': no image yet"
-        return
-    w, h = texture.size
-    data = np.frombuffer(texture.read(), np.uint8).reshape(h, w, 4)[::-1, :, :3]
-    try:
-        Image.fromarray(np.ascontiguousarray(data)).save(path)
-        state.status = f"screenshot {path}"
-    except (OSError, ValueError) as exc:
-        state.error = f"screenshot '{path}': cannot write ({exc})"

@@ -7,10 +7,11 @@ next to it the same faces weighted by their delta form factors. The sums per fac
 the patch's row of F. Below, F as an ImPlot heat map (block means when N > ``HEATMAP_MAX``)
 and its row sums (1 in a closed scene).
 
-Everything is computed on the viewer's GL context in the UI thread with
-:class:`shadelab.render.hemicube.Hemicube`, cached per geometry (the patches' key: a material
-or emission edit keeps it) and patch; F's rows come ``Hemicube.batch`` per frame, so the UI
-never waits. The helpers above ``draw_panel`` are numpy only (tests use them).
+The window asks the viewer's GL side for the work (``state.gpu`` requests, served by
+:mod:`shadelab.ui.gpu_side` with :class:`shadelab.render.hemicube.Hemicube` before the next
+frame's panels): a patch's item images, and F's rows ``Hemicube.batch`` per frame, so the UI
+never waits. Results are cached per geometry (the patches' key: a material or emission edit
+keeps it) and patch. This module holds no GL object and imports no GL module.
 """
 
 from __future__ import annotations
@@ -117,14 +118,15 @@ def patch_id_soup(polygons: np.ndarray, exposure: float = 1.0) -> np.ndarray:
     return out
 
 
-# ---------------------------------------------------------------- GL side (UI thread)
+# ---------------------------------------------------------------- the window's state
 
 
 @dataclass
 class RadiosityView:
     key: object = None
     patches: object = None
-    cube: object = None                  # Hemicube on the viewer's context
+    res: int = 0                         # hemicube resolution (the GL side's, once known)
+    batch: int = 0                       # rows of F per request (one atlas read-back)
     F: np.ndarray | None = None
     rows_done: int = 0
     patch: int = 0
@@ -140,6 +142,7 @@ _views: dict[int, RadiosityView] = {}
 
 
 FIRST_FRAMES = 2   # frames the viewer draws before this window builds its patches
+ROWS, IMAGES = "hemicube_rows", "hemicube_images"   # the GPU requests (shadelab.ui.gpu_side)
 
 
 def view_of(state) -> RadiosityView:
@@ -153,25 +156,23 @@ def geometry_key(scene) -> tuple:
 
 
 def ensure(state, view: RadiosityView | None = None) -> RadiosityView:
-    """Patches and the hemicube for the scene's geometry (rebuilt when it changed)."""
+    """Patches for the scene's geometry (rebuilt when it changed; the GL side makes the
+    hemicube of them on the first request)."""
     from shadelab.errors import ShadeLabError
     from shadelab.radiosity.patches import check_count, uniform_patches
-    from shadelab.render.hemicube import Hemicube
 
     view = view or view_of(state)
     scene = state.scene
     key = geometry_key(scene)
     if key == view.key:
         return view
-    release(view)
     view.key, view.views, view.shown, view.error = key, {}, None, ""
+    view.res, view.batch = 0, 0
     try:
         check_count(scene.radiosity.patches, "radiosity.patches")
         view.patches = uniform_patches(scene, scene.radiosity.patches)
-        view.cube = Hemicube(view.patches, scene.radiosity.hemicube_resolution,
-                             ctx=state.gl.ctx)
     except ShadeLabError as exc:
-        view.patches, view.cube, view.error = None, None, str(exc)
+        view.patches, view.error = None, str(exc)
         return view
     n = len(view.patches)
     view.F, view.rows_done = np.zeros((n, n)), 0
@@ -180,31 +181,43 @@ def ensure(state, view: RadiosityView | None = None) -> RadiosityView:
     return view
 
 
-def step_rows(view: RadiosityView, batches: int = 1) -> None:
-    """Compute the next ``batches`` x ``cube.batch`` rows of F."""
-    if view.cube is None:
-        return
-    n = len(view.patches)
-    for _ in range(batches):
-        if view.rows_done >= n:
-            return
-        rows = np.arange(view.rows_done, min(n, view.rows_done + view.cube.batch))
-        view.F[rows] = view.cube.rows(rows)
-        view.rows_done = int(rows[-1]) + 1
+def _ask(state, view: RadiosityView, what: str, **args) -> None:
+    state.gpu.request(what, what, key=view.key, patches=view.patches,
+                      resolution=state.scene.radiosity.hemicube_resolution, **args)
 
 
-def patch_view(view: RadiosityView, i: int) -> dict:
-    if i not in view.views:
+def _result(state, view: RadiosityView, what: str) -> dict | None:
+    """The GL side's answer to ``what`` for this geometry (an error goes to ``view.error``)."""
+    if what in state.gpu.errors:
+        view.error = state.gpu.errors.pop(what)
+    result = state.gpu.take(what)
+    if result is None or result["key"] != view.key:
+        return None
+    view.res = result["res"]
+    return result
+
+
+def step_rows(state, view: RadiosityView) -> None:
+    """Take the rows of F the GL side computed last frame; ask for the next batch."""
+    result = _result(state, view, ROWS)
+    if result is not None and result["rows"].size and int(result["rows"][0]) == view.rows_done:
+        view.F[result["rows"]] = result["values"]
+        view.rows_done = int(result["rows"][-1]) + 1
+        view.batch = result["batch"]
+    if view.rows_done < len(view.patches) and not state.gpu.pending(ROWS):
+        _ask(state, view, ROWS, start=view.rows_done)
+
+
+def patch_view(state, view: RadiosityView, i: int) -> dict | None:
+    """:func:`hemicube_view` of patch ``i`` (None while the GL side renders its hemicube)."""
+    result = _result(state, view, IMAGES)
+    if result is not None:
         if len(view.views) > 64:
             view.views.clear()
-        view.views[i] = hemicube_view(view.cube.item_images(i))
-    return view.views[i]
-
-
-def release(view: RadiosityView) -> None:
-    if view.cube is not None:
-        view.cube.release()
-    view.cube = None
+        view.views[result["patch"]] = hemicube_view(result["images"])
+    if i not in view.views and not state.gpu.pending(IMAGES):
+        _ask(state, view, IMAGES, patch=i)
+    return view.views.get(i)
 
 
 def viewport_soup(state, soup):
@@ -221,7 +234,7 @@ def draw_panel(state) -> bool:
     """The "Hemicube & F" window. Returns False (it edits no scene field)."""
     from imgui_bundle import imgui, implot
 
-    if state.gl is None:
+    if not state.gpu.attached:
         imgui.text("(no GL context yet)")
         return False
     if state.frame < FIRST_FRAMES:   # the scene's first frame comes first (about a second)
@@ -232,7 +245,7 @@ def draw_panel(state) -> bool:
         imgui.text_colored(imgui.ImVec4(1.0, 0.35, 0.3, 1.0), view.error)
         return False
     n = len(view.patches)
-    step_rows(view)
+    step_rows(state, view)
     pv = state.pipeline_view
     shooter = None if pv is None else pv.stats.get("shooter_index")
     _, view.follow = imgui.checkbox("follow the shooting patch", view.follow)
@@ -244,21 +257,29 @@ def draw_panel(state) -> bool:
     if changed:
         view.patch, view.follow = int(value), False
     i = view.patch
-    hv = patch_view(view, i)
-    if view.shown != (view.key, i):
+    hv = patch_view(state, view, i)
+    if hv is not None and view.shown != (view.key, i):
         colors, weighted = cross_images(hv)
-        state.gl.upload_image("hemicube_ids", colors)
-        state.gl.upload_image("hemicube_dF", weighted)
+        state.gpu.upload("hemicube_ids", colors)
+        state.gpu.upload("hemicube_dF", weighted)
         view.shown = (view.key, i)
     width = imgui.get_content_region_avail().x
     side = max(64.0, min(360.0, (width - 12) / 2))
-    for name in ("hemicube_ids", "hemicube_dF"):
-        tex = state.gl.images[name]
-        imgui.image(imgui.ImTextureRef(tex.glo), imgui.ImVec2(side, side))
+    textures = [state.gpu.texture(name) for name in ("hemicube_ids", "hemicube_dF")]
+    if view.shown is None or None in textures:   # the first hemicube is on its way
+        imgui.text(f"rendering the hemicube of patch {i} ...")
+        return False
+    for tex in textures:
+        imgui.image(imgui.ImTextureRef(tex.id), imgui.ImVec2(side, side))
         imgui.same_line()
     imgui.new_line()
-    imgui.text(f"patch {i} of {n}: item buffer (left), x delta form factors (right); "
-               f"hemicube {view.cube.res}x{view.cube.res}")
+    shown = view.shown[1]
+    imgui.text(f"patch {shown} of {n}: item buffer (left), x delta form factors (right); "
+               f"hemicube {view.res}x{view.res}")
+    hv = view.views.get(shown, hv)
+    if hv is None:
+        return False
+    i = shown
     sums = hv["face_sums"]
     imgui.text("  ".join(f"{k} {v:.4f}" for k, v in sums.items()))
     row_sum = float(view.F[i].sum()) if i < view.rows_done else None

@@ -2,8 +2,9 @@
 lesson), plus undo history and the autosaved session.
 
 Pure module (no GL, no GUI): the panels read and write an :class:`AppState`; the GL side keeps
-its resources elsewhere (:mod:`shadelab.ui.viewport`; ``AppState.gl`` is only a handle to it,
-imported for its type alone).
+its resources elsewhere (:mod:`shadelab.ui.viewport`, :mod:`shadelab.ui.gpu_side`). What the
+panels ask of the GPU goes through ``AppState.gpu``, a :class:`shadelab.ui.gpu_queue.GpuQueue`
+of numpy images, requests and plain results.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from typing import TYPE_CHECKING
 from shadelab.errors import ShadeLabError
 from shadelab.scene.model import Camera, Scene
 from shadelab.scene.preset import clone_scene, load_preset, save_preset, scene_to_dict
+from shadelab.ui.gpu_queue import GpuQueue
 
 # One file, written atomically; a damaged one is moved aside and never stops the viewer
 # (shadelab.ui.session). Re-exported here, where the viewer has always found them.
@@ -35,7 +37,6 @@ if TYPE_CHECKING:  # types only (no import at run time: the GL side stays out of
     from shadelab.ui.pipeline_view import PipelineView
     from shadelab.ui.probe import ProbeResult
     from shadelab.ui.studies import StudyRun
-    from shadelab.ui.viewport import Viewport
 
 COMPARE_VIEWS = (("flat", "phong"), ("gouraud", "phong"), ("phong", "phong"), ("phong", "blinn"))
 COMPARE_LABELS = ("Flat", "Gouraud", "Phong", "Blinn-Phong")
@@ -244,7 +245,7 @@ class AppState:
     autosave_due: bool = False
     frame: int = 0
     scene_version: int = 0            # bumped by every scene edit and load
-    gl: Viewport | None = None        # the GL side (GL thread only; the Viewer sets it)
+    gpu: GpuQueue = field(default_factory=GpuQueue)  # images and GPU work for the GL side
 
     @classmethod
     def from_scene(cls, scene: Scene, source: str, **kwargs) -> "AppState":
