@@ -13,6 +13,7 @@ from shadelab.scene.camera import (
     clip_from_world,
     gl_matrix,
     primary_rays,
+    tan_half_fov_y,
     view_from_world,
 )
 from shadelab.scene.model import Camera
@@ -22,8 +23,8 @@ CAMERA = Camera(eye=(1.0, 2.0, 5.0), target=(0.2, -0.3, 0.0), up=(0.0, 1.0, 0.0)
 
 
 @pytest.mark.parametrize("far", [50.0, math.inf])
-def test_primary_ray_points_project_to_their_pixel_centres(far):
-    w, h = 40, 30
+@pytest.mark.parametrize("w, h", [(40, 30), (24, 40)])   # landscape; portrait (fov widened)
+def test_primary_ray_points_project_to_their_pixel_centres(far, w, h):
     origins, dirs = primary_rays(CAMERA, w, h)
     points = origins + 3.7 * dirs                       # (h, w, 3), 3.7 units along each ray
     homogeneous = np.concatenate([points, np.ones((h, w, 1))], axis=-1)
@@ -52,3 +53,19 @@ def test_gl_matrix_is_column_major():
     m = np.arange(16, dtype=np.float64).reshape(4, 4)
     data = np.frombuffer(gl_matrix(m), dtype=np.float32)
     np.testing.assert_array_equal(data[:4], m[:, 0])    # first column first, as GLSL reads it
+
+
+@pytest.mark.parametrize("fit", [1.0, 4.0 / 3.0, 16.0 / 9.0])
+def test_a_narrow_image_keeps_the_fit_aspects_frame_side_to_side(fit):
+    camera = Camera(eye=(0.0, 0.0, 5.0), target=(0.0, 0.0, 0.0), fov_y=40.0, fit_aspect=fit)
+    t = math.tan(math.radians(40.0) / 2.0)
+    for aspect in (fit, 2.0, 3.5):                       # as wide as the frame or wider: fov_y
+        assert tan_half_fov_y(camera, aspect) == pytest.approx(t, rel=1e-15)
+    for aspect in (0.5, 0.75, fit * 0.99):               # narrower: same horizontal half-width
+        assert tan_half_fov_y(camera, aspect) * aspect == pytest.approx(t * fit, rel=1e-12)
+        # the raster's projection says the same: x_ndc = 1 at the fit frame's edge
+        edge = np.array([t * fit * 5.0, 0.0, 0.0, 1.0])
+        clip = clip_from_world(camera, aspect, 50.0) @ edge
+        assert clip[0] / clip[3] == pytest.approx(1.0, rel=1e-9)
+    camera.fit_aspect = 0.0                               # 0: never widened
+    assert tan_half_fov_y(camera, 0.3) == pytest.approx(t, rel=1e-15)

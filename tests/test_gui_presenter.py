@@ -226,7 +226,7 @@ def scenario_gizmo_drag(ctx, state, out: dict) -> None:
     ctx.mouse_up(0)
     ctx.yield_(4)
     out["before"], out["after"] = before, list(state.scene.lights[0].position)
-    out["pixel_size"] = gizmos.pixel_size_at(state, before, size[1])
+    out["pixel_size"] = gizmos.pixel_size_at(state, before, size[1], size[0])
     out["camera_unchanged"] = tuple(state.scene.camera.eye) == camera
     out["undo_steps"] = state.history.index - steps_before
     state.undo()

@@ -4,6 +4,7 @@ scene, the numba BVH's, and the path tracer's samples/s on cornell."""
 
 from __future__ import annotations
 
+import math
 import time
 
 import numba
@@ -13,7 +14,7 @@ from shadelab.raytrace.accel import BvhAccel, accel_threads, embree_available
 from shadelab.raytrace.pathtrace import PathTracer
 from shadelab.raytrace.surface import TraceContext
 from shadelab.raytrace.whitted import iter_raytrace
-from shadelab.scene.camera import primary_rays
+from shadelab.scene.camera import primary_rays, tan_half_fov_y
 from shadelab.scene.preset import load_preset
 from shadelab.timing import median_time
 
@@ -151,9 +152,10 @@ def _mitsuba(size, spp: int, repeats: int) -> dict:
         shapes[f"m{m.index}"] = mesh
     cam = scene.camera
     width, height = size
+    fov_y = math.degrees(2.0 * math.atan(tan_half_fov_y(cam, width / height)))
     mscene = mi.load_dict({
         "type": "scene", "integrator": {"type": "path", "max_depth": -1, "rr_depth": 5},
-        "sensor": {"type": "perspective", "fov": cam.fov_y, "fov_axis": "y",
+        "sensor": {"type": "perspective", "fov": fov_y, "fov_axis": "y",
                    "to_world": mi.ScalarTransform4f().look_at(origin=list(cam.eye),
                                                               target=list(cam.target),
                                                               up=list(cam.up)),

@@ -44,7 +44,6 @@ Emitters are two-sided (a closed furnace box converges to Le / (1 - rho) seen fr
 
 from __future__ import annotations
 
-import math
 import time
 from typing import Iterator
 
@@ -537,8 +536,9 @@ class TileJob:
 
     def __init__(self, scene: Scene, size: tuple[int, int], spp: int, seed: int,
                  backend: str, local: str):
-        from shadelab.scene.camera import (
-            camera_basis,  # the camera's own frame, so the images align
+        from shadelab.scene.camera import (  # the camera's own frame, so the images align
+            camera_basis,
+            tan_half_fov_y,
         )
 
         self.tracer = PathTracer(scene, backend, local=local)
@@ -546,7 +546,7 @@ class TileJob:
         cam = scene.camera
         self.frame = camera_basis(cam)
         self.eye = np.asarray(cam.eye, dtype=np.float64)
-        self.tan_half = math.tan(math.radians(cam.fov_y) / 2.0)
+        self.tan_half = tan_half_fov_y(cam, size[0] / size[1])
 
     def __call__(self, sample: int, r0: int, r1: int):
         """(radiance (n, 3), rays cast, primary hits) of one tile."""

@@ -299,14 +299,17 @@ def _tile_rays(scene: Scene, size: tuple[int, int], spp: int, seed: int, workspa
     """rays(sample, r0, r1) -> (origins, dirs) of a tile, flattened, as
     :func:`shadelab.scene.camera.primary_rays` gives them (a numba mirror, per tile); with a
     ``workspace`` the arrays are reused from tile to tile (valid until the next call)."""
-    from shadelab.scene.camera import camera_basis  # the camera's own frame, so the images align
+    from shadelab.scene.camera import (  # the camera's own frame, so the images align
+        camera_basis,
+        tan_half_fov_y,
+    )
 
     width, height = size
     rng = np.random.default_rng(seed)
     cam = scene.camera
     forward, right, up = camera_basis(cam)
     eye = np.asarray(cam.eye, dtype=np.float64)
-    tan_half = math.tan(math.radians(cam.fov_y) / 2.0)
+    tan_half = tan_half_fov_y(cam, width / height)
     cache: dict = {}
 
     def rays(sample: int, r0: int, r1: int):

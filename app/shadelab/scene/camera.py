@@ -29,6 +29,21 @@ def camera_basis(camera: Camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return forward, right, up
 
 
+def tan_half_fov_y(camera: Camera, aspect: float) -> float:
+    """tan(half the vertical field of view) of an image ``aspect`` = width / height wide.
+
+    It is ``tan(fov_y / 2)``, widened when the image is narrower than ``camera.fit_aspect``
+    (a portrait viewport, a narrow presenter column) so that the frame ``fov_y`` shows at that
+    aspect stays in view left to right (Mitsuba's ``fov_axis = "smaller"`` when it is 1). The
+    one source of the projection's scale: the raster, both ray tracers, the probe, gizmos and
+    camera drags read it, so their images stay aligned at every aspect."""
+    t = math.tan(math.radians(camera.fov_y) / 2.0)
+    fit = float(camera.fit_aspect)
+    if fit > 0.0 and 0.0 < aspect < fit:
+        t *= fit / aspect
+    return t
+
+
 def view_from_world(camera: Camera) -> np.ndarray:
     """4x4 float64 ``view_from_world`` (column vectors): the eye at the origin looking down -z."""
     forward, _, up = camera_basis(camera)
@@ -38,15 +53,18 @@ def view_from_world(camera: Camera) -> np.ndarray:
 
 def clip_from_view(camera: Camera, aspect: float, far: float) -> np.ndarray:
     """4x4 float64 ``clip_from_view`` (column vectors): a perspective with the camera's vertical
-    fov; ``far`` may be inf (the infinite far plane of Everitt & Kilgard 2002)."""
+    fov (:func:`tan_half_fov_y`); ``far`` may be inf (the infinite far plane of Everitt &
+    Kilgard 2002)."""
+    tan_half = tan_half_fov_y(camera, aspect)
     if math.isinf(far):
-        f = 1.0 / math.tan(math.radians(camera.fov_y) / 2.0)
+        f = 1.0 / tan_half
         near = camera.near
         return np.array([[f / aspect, 0, 0, 0],
                          [0, f, 0, 0],
                          [0, 0, -1.0, -2.0 * near],
                          [0, 0, -1.0, 0]], dtype=np.float64)
-    return np.asarray(Matrix44.perspective_projection(camera.fov_y, aspect, camera.near, far),
+    fov_y = math.degrees(2.0 * math.atan(tan_half))
+    return np.asarray(Matrix44.perspective_projection(fov_y, aspect, camera.near, far),
                       dtype=np.float64).T
 
 
@@ -77,8 +95,8 @@ def primary_rays(camera: Camera, width: int, height: int,
     anti-aliasing); without it the ray passes through the centre, as the rasterizer samples.
     """
     forward, right, up = camera_basis(camera)
-    tan_half = math.tan(math.radians(camera.fov_y) / 2.0)
     aspect = width / height
+    tan_half = tan_half_fov_y(camera, aspect)
     offset = np.full((height, width, 2), 0.5) if jitter is None else jitter
     cols = (np.arange(width)[None, :] + offset[..., 0]) / width
     rows = (np.arange(height)[:, None] + offset[..., 1]) / height

@@ -86,12 +86,17 @@ _VALIDATE: Any = None
 
 @dataclass
 class Camera(Checked):
-    """A pinhole camera; ``fov_y`` is the full vertical field of view in degrees."""
+    """A pinhole camera; ``fov_y`` is the full vertical field of view in degrees (widened in an
+    image narrower than ``fit_aspect``: :func:`shadelab.scene.camera.tan_half_fov_y`)."""
 
     eye: Point3 = spec((0.0, 1.0, 5.0), "vec3", *COORD, doc="camera position, world units")
     target: Point3 = spec((0.0, 0.0, 0.0), "vec3", *COORD, doc="point looked at")
     up: Vec3 = spec((0.0, 1.0, 0.0), "vec3", *COORD, doc="up direction")
     fov_y: float = spec(45.0, "float", 1.0, 170.0, doc="vertical field of view, degrees")
+    fit_aspect: float = spec(1.0, "float", 0.0, 8.0,
+                             doc="narrowest width/height kept in view: a narrower image widens "
+                                 "the vertical fov so fov_y's frame at this aspect fits side "
+                                 "to side (0: never)")
     near: float = spec(0.1, "float", 1e-6, LENGTH_MAX, doc="near clipping distance, world units")
 
 

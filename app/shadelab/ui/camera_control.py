@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 
+from shadelab.scene.camera import tan_half_fov_y
 from shadelab.scene.model import Camera
 
 ORBIT_SPEED = 0.008        # radians per pixel dragged, when no window height is given
@@ -39,8 +40,9 @@ def orbit(camera: Camera, dx: float, dy: float, height: int = 0) -> None:
     camera.eye = tuple(float(c) for c in target + radius * new_d)
 
 
-def pan(camera: Camera, dx: float, dy: float, height: int) -> None:
-    """Slide eye and target together so the scene follows the mouse."""
+def pan(camera: Camera, dx: float, dy: float, height: int, width: int = 0) -> None:
+    """Slide eye and target together so the scene follows the mouse (``width``, when known,
+    lets a viewport narrower than the camera's fit aspect widen the field of view)."""
     eye, target = np.asarray(camera.eye, float), np.asarray(camera.target, float)
     forward = target - eye
     distance = np.linalg.norm(forward)
@@ -48,7 +50,7 @@ def pan(camera: Camera, dx: float, dy: float, height: int) -> None:
     right = np.cross(forward, camera.up)
     right /= np.linalg.norm(right)
     up = np.cross(right, forward)
-    per_pixel = 2.0 * distance * math.tan(math.radians(camera.fov_y) / 2.0) / max(height, 1)
+    per_pixel = 2.0 * distance * tan_half_fov_y(camera, width / max(height, 1)) / max(height, 1)
     shift = (-dx * right + dy * up) * per_pixel
     camera.eye = tuple(float(c) for c in eye + shift)
     camera.target = tuple(float(c) for c in target + shift)
@@ -63,9 +65,9 @@ def zoom(camera: Camera, notches: float) -> None:
 
 
 def drag(camera: Camera, dx: float, dy: float, rotate: bool, orbit_height: int,
-         pan_height: int) -> None:
+         pan_height: int, pan_width: int = 0) -> None:
     """A mouse drag: orbit with the left button (``rotate``), else pan."""
     if rotate:
         orbit(camera, dx, dy, orbit_height)
     else:
-        pan(camera, dx, dy, pan_height)
+        pan(camera, dx, dy, pan_height, pan_width)

@@ -14,7 +14,7 @@ import math
 import numpy as np
 from imgui_bundle import imgui, imguizmo
 
-from shadelab.scene.camera import clip_from_view, view_from_world
+from shadelab.scene.camera import clip_from_view, tan_half_fov_y, view_from_world
 from shadelab.ui.state import AppState
 
 GIZMO = imguizmo.im_guizmo
@@ -60,13 +60,14 @@ def projector(state: AppState, size: tuple[int, int]):
     return project, view, proj
 
 
-def pixel_size_at(state: AppState, point, height: int) -> float:
-    """World length of one viewport pixel at ``point``'s depth (for tests and drag speeds)."""
+def pixel_size_at(state: AppState, point, height: int, width: int = 0) -> float:
+    """World length of one viewport pixel at ``point``'s depth (for tests and drag speeds);
+    ``width`` (when known) lets a viewport narrower than the camera's fit aspect widen it."""
     cam = state.scene.camera
     forward = np.subtract(cam.target, cam.eye)
     forward = forward / np.linalg.norm(forward)
     depth = float(np.dot(np.subtract(point, cam.eye), forward))
-    return 2.0 * depth * math.tan(math.radians(cam.fov_y) / 2.0) / max(height, 1)
+    return 2.0 * depth * tan_half_fov_y(cam, width / max(height, 1)) / max(height, 1)
 
 
 def draw(state: AppState, origin, size: tuple[int, int]) -> bool:

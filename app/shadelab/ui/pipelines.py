@@ -355,13 +355,13 @@ def pick_ray_tree(state: AppState, name: str, pixel, display_size) -> None:
 
 def project(scene, size: tuple[int, int], points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Screen (x, y) in [0, size] of world points and whether each is in front of the eye."""
-    from shadelab.scene.camera import camera_basis
+    from shadelab.scene.camera import camera_basis, tan_half_fov_y
 
     forward, right, up = camera_basis(scene.camera)
     rel = np.asarray(points, float) - np.asarray(scene.camera.eye, float)
     z = rel @ forward
-    tan_half = np.tan(np.radians(scene.camera.fov_y) / 2.0)
     aspect = size[0] / max(size[1], 1)
+    tan_half = tan_half_fov_y(scene.camera, aspect)
     zs = np.maximum(z, 1e-9)
     x = (rel @ right) / (zs * tan_half * aspect)
     y = (rel @ up) / (zs * tan_half)
