@@ -8,7 +8,6 @@ snapshots, autosave, window title).
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
@@ -19,6 +18,7 @@ from imgui_bundle import hello_imgui, imgui, immapp
 from shadelab.geometry.mesh import geometry_key, scene_meshes
 from shadelab.ui import (
     camera_control,
+    compare_view,
     gizmos,
     lesson,
     overlays,
@@ -28,20 +28,17 @@ from shadelab.ui import (
     presenter,
     radiosity_view,
 )
+from shadelab.ui.autosave import Autosave
 from shadelab.ui.followups import FollowUps, ViewerOptions, write_window_screenshot
 from shadelab.ui.frame import guarded
 from shadelab.ui.offline import draw_offline_panel
-from shadelab.ui.probe import probe
 from shadelab.ui.recorder import FrameRecorder
 from shadelab.ui.render_panel import draw_algorithms_panel
 from shadelab.ui.state import (
-    AUTOSAVE_INTERVAL,
-    COMPARE_LABELS,
-    COMPARE_VIEWS,
     AppState,
-    save_session,
 )
 from shadelab.ui.studies_panel import draw_gallery_panel, draw_studies_panel
+from shadelab.ui.viewport_reads import update_probe, write_viewport_screenshot
 
 PRESENTER_SCALE = 1.8      # font scale of presenter mode
 WARM_JOBS_AT_FRAME = 60    # start the offline-job process once the window is up
@@ -147,7 +144,7 @@ class Viewer:
     viewport: object = None            # shadelab.ui.viewport.Viewport, made in post_init
     gpu: object = None                 # shadelab.ui.gpu_side.GpuSide: serves state.gpu
     drag: float = 0.0                  # pixels moved since the mouse went down
-    last_autosave: float = 0.0
+    autosave: Autosave = field(default_factory=Autosave)  # the session file, now and then
     title: str = ""
     recorder: FrameRecorder = field(default_factory=FrameRecorder)  # frame times, the bench
     _line_cache: dict = field(default_factory=dict)
@@ -183,7 +180,7 @@ class Viewer:
         if self.state.study is not None:
             self.state.study.shutdown()
         if self.options.autosave:
-            self.autosave(force=True)
+            self.autosave(self.state, force=True)
         if self.options.bench_json:
             self.recorder.write(self.options.bench_json, self.options.window_size,
                                 pipelines.bench_report(self.state))  # jobs: first_image_s...
@@ -204,7 +201,7 @@ class Viewer:
             state.probe_requested = True  # the same pixel shows another point now
         state.viewport_size = size
         if state.compare:
-            self.draw_compare(size)
+            compare_view.draw_compare(self, size)
         else:
             self.draw_main(size)
         if not state.compare:
@@ -288,7 +285,7 @@ class Viewer:
                                  self.samples())
         # --- PASS 3: the probe reads the GPU value before any overlay is drawn
         if state.probe_requested:
-            self.update_probe(size, display_size)
+            update_probe(state, vp, size, display_size, self.samples())
         # --- PASS 4: overlays (wireframe, normal glyphs, probe arrows)
         exposure = scene.render.exposure
         meshes = scene_meshes(scene)
@@ -307,7 +304,7 @@ class Viewer:
         # --- PASS 5: exposure, tone map + sRGB for display
         texture = vp.present(pane, exposure, tonemap=state.tonemap, clipping=state.show_clipping)
         if state.screenshot_requested:
-            self.write_viewport_screenshot(state.screenshot_requested)
+            write_viewport_screenshot(state, vp, state.screenshot_requested)
             state.screenshot_requested = ""
         self._handle_click(self._image_with_input(texture, display_size), display_size)
 
@@ -349,116 +346,6 @@ class Viewer:
             self._line_cache[key] = lines
         return self._line_cache[key]
 
-    def update_probe(self, size: tuple[int, int], display_size: tuple[int, int]) -> None:
-        """Recompute the probed pixel's terms (CPU reference) and read what the GPU drew.
-
-        ``state.probe_pixel`` is in viewport pixels; the scene may be rendered at another
-        resolution (render scale), so the pixel is mapped to the rendered image first.
-        """
-        state = self.state
-        shown = state.probe_pixel
-        if shown is None or not (0 <= shown[0] < display_size[0]
-                                 and 0 <= shown[1] < display_size[1]):
-            state.probe = None
-            state.probe_version += 1
-            return  # (kept requested: the layout may still be settling)
-        pixel = (min(int(shown[0] * size[0] / display_size[0]), size[0] - 1),
-                 min(int(shown[1] * size[1] / display_size[1]), size[1] - 1))
-        state.probe_requested = False
-        result = probe(state.scene, size, pixel)
-        if result is not None and not state.show_radiosity:
-            key = "main"
-            if self.samples() > 1:  # a resolved edge pixel averages both sides: read 1 sample
-                key = "probe"
-                self.viewport.draw_scene(key, state.scene, size, state.scene.render.shading,
-                                         state.scene.render.specular)
-            result.gpu = self.viewport.read_pixel(key, pixel)
-        state.probe = result
-        state.probe_version += 1
-        if result is None:
-            state.status = f"pixel {pixel}: background (no surface)"
-
-    def draw_compare(self, size: tuple[int, int]) -> None:
-        state, vp = self.state, self.viewport
-        scene = state.scene
-        # Four quadrants; with the heat map, the map takes 70% of the width at full height.
-        if state.diff_enabled:
-            half = (max(int(size[0] * 0.7), 8), max(size[1], 8))
-        else:
-            half = (max(size[0] // 2, 8), max(size[1] // 2, 8))
-        exposure = scene.render.exposure
-        if "compare3" in vp.panes and self.unchanged(size):
-            panes = [vp.panes[f"compare{i}"] for i in range(len(COMPARE_VIEWS))]
-        else:
-            panes = [vp.draw_scene(f"compare{i}", scene, half, shading, specular, self.samples())
-                     for i, (shading, specular) in enumerate(COMPARE_VIEWS)]
-        if state.diff_enabled:
-            a, b = state.diff_pair
-            diff = vp.pane("diff", half)
-            vp.present(diff, exposure, panes[a], panes[b], state.diff_scale)
-            origin = imgui.get_cursor_screen_pos()
-            texture = diff.display
-            self._image_with_input(texture, half)
-            draw = imgui.get_window_draw_list()
-            draw.add_text(imgui.ImVec2(origin.x + 6, origin.y + 4), 0xFFFFFFFF,
-                          f"|{COMPARE_LABELS[a]} - {COMPARE_LABELS[b]}| x exposure, "
-                          f"full red = {state.diff_scale:.3g}")
-            imgui.same_line()
-            imgui.begin_group()
-            thumb_w = max(size[0] - half[0] - 12, 8)
-            thumb_h = min(thumb_w * half[1] / half[0], size[1] / 2 - 30)
-            for i in (a, b):
-                tex = vp.present(panes[i], exposure)
-                imgui.image(imgui.ImTextureRef(tex.glo),
-                            imgui.ImVec2(thumb_h * half[0] / half[1], thumb_h),
-                            uv0=imgui.ImVec2(0, 1), uv1=imgui.ImVec2(1, 0))
-                imgui.text(COMPARE_LABELS[i])
-            imgui.end_group()
-            return
-        origin = imgui.get_cursor_screen_pos()
-        for pane in panes:
-            vp.present(pane, exposure, tonemap=state.tonemap, clipping=state.show_clipping)
-        draw = imgui.get_window_draw_list()
-        for i, pane in enumerate(panes):
-            x = origin.x + (i % 2) * half[0]
-            y = origin.y + (i // 2) * half[1]
-            imgui.set_cursor_screen_pos(imgui.ImVec2(x, y))
-            imgui.image(imgui.ImTextureRef(pane.display.glo), imgui.ImVec2(*half),
-                        uv0=imgui.ImVec2(0, 1), uv1=imgui.ImVec2(1, 0))
-            draw.add_text(imgui.ImVec2(x + 6, y + 4), 0xFFFFFFFF, COMPARE_LABELS[i])
-        # One input area over the grid drives the shared camera.
-        imgui.set_cursor_screen_pos(origin)
-        self._grid_input((half[0] * 2, half[1] * 2), half[1])
-
-    def _grid_input(self, size: tuple[int, int], pane_height: int) -> None:
-        state, io = self.state, imgui.get_io()
-        imgui.invisible_button("compare_input", imgui.ImVec2(*size),
-                               imgui.ButtonFlags_.mouse_button_left
-                               | imgui.ButtonFlags_.mouse_button_right)
-        camera = state.scene.camera
-        if imgui.is_item_active() and (io.mouse_delta.x or io.mouse_delta.y):
-            camera_control.drag(camera, io.mouse_delta.x, io.mouse_delta.y,
-                                imgui.is_mouse_down(imgui.MouseButton_.left), size[1], pane_height)
-            state.mark_edited()
-        if imgui.is_item_hovered() and io.mouse_wheel:
-            camera_control.zoom(camera, io.mouse_wheel)
-            state.mark_edited()
-
-    # ------------------------------------------------------------ screenshots
-    def write_viewport_screenshot(self, path: str) -> None:
-        from PIL import Image
-
-        from shadelab.ui.legend import burn_legend
-
-        image = self.viewport.read_display("main")
-        if self.state.legend_in_screenshot:
-            image = burn_legend(image, self.state)
-        try:
-            Image.fromarray(image).save(path)
-            self.state.status = f"screenshot {path}"
-        except (OSError, ValueError) as exc:
-            self.state.error = f"screenshot '{path}': cannot write ({exc})"
-
     # ------------------------------------------------------------ per frame
     def begin_frame(self) -> None:
         """Before any panel draws: the GPU work and images the panels queued last frame."""
@@ -491,7 +378,7 @@ class Viewer:
         if state.edit_pending and not imgui.is_any_item_active() and not gizmos.capturing():
             state.commit_edit()
         if self.options.autosave:
-            self.autosave()
+            self.autosave(self.state)
         self.update_title()
         state.frame += 1
         if state.frame == WARM_JOBS_AT_FRAME and not (self.options.frames
@@ -507,20 +394,6 @@ class Viewer:
         """After the frame is on screen (:meth:`FrameRecorder.frame_swapped`)."""
         if self.recorder.frame_swapped() and self.warm_after_first_frame:
             pipelines.warm(self.state)  # the job process imports while the user looks
-
-    def autosave(self, force: bool = False) -> None:
-        state = self.state
-        now = time.perf_counter()
-        if not state.autosave_due or state.edit_pending and not force:
-            return
-        if not force and now - self.last_autosave < AUTOSAVE_INTERVAL:
-            return
-        try:
-            save_session(state.scene, state.source)
-            state.autosave_due = False
-        except Exception as exc:  # a full disk must not take the session down
-            state.error = f"autosave failed: {exc}"
-        self.last_autosave = now
 
     def update_title(self) -> None:
         title = self.state.title()
