@@ -19,6 +19,10 @@ Casters
   (near cap), its three edges extruded, and the reversed triangle at infinity (far cap).
   This is always correct (the union of the per-triangle volumes is the shadow) but costs
   more fill than a silhouette volume. Nothing is refused and nothing is "repaired".
+  :func:`open_volume` is that union for one or more open casters with the pairs of sides
+  that cancel left out (neighbours in one plane that face the light the same way: the
+  diagonal of every quad): the same stencil with less fill; the renderer uses it for the
+  opaque open casters, grouped by shared corners (:func:`open_caster_groups`).
 
 Per-triangle volumes start beyond their triangle along the light's rays (far enough to be
 ``offset`` off the triangle's plane, up to ``GRAZING_LIMIT`` offsets at grazing light), so the
@@ -188,25 +192,148 @@ def shadow_volume(vertices: np.ndarray, faces: np.ndarray, light: np.ndarray,
         # volume would open a lit gap where the caster touches a receiver (a box on a floor).
         shift = np.zeros_like(v)
         return ShadowVolume(_homogeneous(v, light, shift), volume_faces, edges, "silhouette")
+    return per_triangle_volume(vertices, faces, light, offset)
+
+
+def per_triangle_volume(vertices: np.ndarray, faces: np.ndarray, light: np.ndarray,
+                        offset: float = 0.0) -> ShadowVolume:
+    """One small closed volume per triangle (any caster; :func:`shadow_volume`'s choice for
+    the ones that are not closed): the union of these volumes is the shadow."""
+    vertices = np.asarray(vertices, dtype=np.float64)
+    faces = np.asarray(faces, dtype=np.int64)
     # Per-triangle volumes: an unshared triangle soup, each turned to face the light.
+    soup, homogeneous = _turned_soup(vertices, faces, light, offset)
+    n = len(soup)
+    caps = np.arange(n, dtype=np.int64).reshape(-1, 3)
+    edges = _soup_edges(caps)
+    volume_faces = np.concatenate([_sides(edges, n), caps, caps[:, ::-1] + n])
+    contour = edges[_contour_edges(faces, facing_light(vertices, faces, light))]
+    return ShadowVolume(homogeneous, volume_faces, contour, "per-triangle")
+
+
+def _turned_soup(vertices: np.ndarray, faces: np.ndarray, light: np.ndarray,
+                 offset: float) -> tuple[np.ndarray, np.ndarray]:
+    """The triangles as a soup (3F, 3), each turned to face the light, and the soup's
+    homogeneous volume vertices (6F, 4): its caps moved off their triangles, then at infinity.
+
+    Each cap moves along the light's rays (so the shadow's outline does not move) far enough
+    to leave ``offset`` between it and its triangle even where the light grazes the surface:
+    t = offset / |N.d|, at most GRAZING_LIMIT times offset."""
     tri = vertices[faces]
     lit = facing_light(vertices, faces, light)
     tri = np.where(lit[:, None, None], tri, tri[:, ::-1])
     soup = tri.reshape(-1, 3)
-    # Each cap moves along the light's rays (so the shadow's outline does not move) far
-    # enough to leave ``offset`` between it and its triangle even where the light grazes the
-    # surface: t = offset / |N.d|, at most GRAZING_LIMIT times offset.
     normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-300)
     away = away_from_light(soup, light)
     cosine = np.abs(np.einsum("ij,ij->i", np.repeat(normal, 3, axis=0), away))
     shift = (offset / np.maximum(cosine, 1.0 / GRAZING_LIMIT))[:, None] * away
+    return soup, _homogeneous(soup, light, shift)
+
+
+def _soup_edges(caps: np.ndarray) -> np.ndarray:
+    """(3F, 2) directed edges of the soup's triangles, in the order 01, 12, 20."""
+    return np.concatenate([caps[:, [0, 1]], caps[:, [1, 2]], caps[:, [2, 0]]])
+
+
+def open_volume(parts: list[tuple[np.ndarray, np.ndarray]], light: np.ndarray,
+                offset: float) -> ShadowVolume:
+    """One volume for open casters (``parts``: (vertices, faces) of one or more meshes): the
+    union of their per-triangle volumes with the sides that cancel left out.
+
+    Every triangle is turned to face the light and moved off itself exactly as in the
+    per-triangle volumes (:func:`shadow_volume`), so the near caps, far caps and the kept
+    sides are those volumes' own faces. Two triangles that share an edge, run along it in
+    opposite directions once turned (neighbours that face the light the same way) and moved
+    its two corners to the same points (neighbours in one plane: the two halves of a quad,
+    coplanar quads that touch) have the same side through it with opposite orientations:
+    their counts cancel, so both are left out. The stencil count, a signed sum over the
+    faces, is the same everywhere; the long sides through a flat mesh's interior edges are
+    gone. Corners are matched by position (and moved point), across the parts too, and the
+    volume stays closed edge for edge (no T-junctions): a pair is dropped only where both
+    corners are shared vertices. Neighbours at an angle move a shared corner by different
+    amounts and keep their sides.
+    """
+    soups, verts = [], []
+    for vertices, faces in parts:
+        soup, homogeneous = _turned_soup(np.asarray(vertices, dtype=np.float64),
+                                         np.asarray(faces, dtype=np.int64), light, offset)
+        soups.append(soup)
+        verts.append(homogeneous)
+    soup = np.concatenate(soups) if soups else np.zeros((0, 3))
     n = len(soup)
-    caps = np.arange(n, dtype=np.int64).reshape(-1, 3)
-    edges = np.concatenate([caps[:, [0, 1]], caps[:, [1, 2]], caps[:, [2, 0]]])
-    volume_faces = np.concatenate([_sides(edges, n), caps, caps[:, ::-1] + n])
-    contour = edges[_contour_edges(faces, facing_light(vertices, faces, light))]
-    return ShadowVolume(_homogeneous(soup, light, shift), volume_faces, contour, "per-triangle")
+    near = np.concatenate([h[: len(h) // 2] for h in verts]) if verts else np.zeros((0, 4))
+    far = np.concatenate([h[len(h) // 2:] for h in verts]) if verts else np.zeros((0, 4))
+    # One vertex per corner position and moved point (to 1e-9 of the offset: the two
+    # halves of a flat quad compute their equal shifts with different rounding)
+    moved = np.linalg.norm(near[:, :3] - soup, axis=1) / max(offset, 1e-300)
+    key = np.concatenate([soup, np.round(moved, 9)[:, None]], axis=1)
+    _, first, canonical = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    canonical = first[canonical.reshape(-1)]
+    caps = canonical.reshape(-1, 3)
+    edges = _soup_edges(caps)
+    first_edge, second_edge = _paired_edges(edges)
+    single = np.ones(len(edges), bool)
+    single[first_edge] = False
+    single[second_edge] = False
+    volume_faces = np.concatenate([_sides(edges[single], n), caps, caps[:, ::-1] + n])
+    return ShadowVolume(np.concatenate([near, far]), volume_faces.astype(np.int64),
+                        edges[single], "open")
+
+
+def _paired_edges(edges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Indices (first, second) into ``edges`` of disjoint pairs of directed edges between the
+    same two vertices in opposite directions (a -> b and b -> a)."""
+    if len(edges) == 0:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    a, b = edges[:, 0], edges[:, 1]
+    lo, hi, forward = np.minimum(a, b), np.maximum(a, b), a < b
+    # Rank each edge among the edges with the same ends and direction, then pair the k-th
+    # a -> b with the k-th b -> a
+    order = np.lexsort((forward, hi, lo))
+    lo, hi, forward = lo[order], hi[order], forward[order]
+    m = len(order)
+    new = np.ones(m, bool)
+    new[1:] = (lo[1:] != lo[:-1]) | (hi[1:] != hi[:-1]) | (forward[1:] != forward[:-1])
+    index = np.arange(m)
+    rank = index - np.maximum.accumulate(np.where(new, index, 0))
+    again = np.lexsort((forward, rank, hi, lo))
+    lo, hi, rank, forward = lo[again], hi[again], rank[again], forward[again]
+    pair = ((lo[:-1] == lo[1:]) & (hi[:-1] == hi[1:]) & (rank[:-1] == rank[1:])
+            & ~forward[:-1] & forward[1:] & (lo[:-1] != hi[:-1]))
+    at = np.flatnonzero(pair)
+    sorted_edges = order[again]
+    return sorted_edges[at + 1], sorted_edges[at]
+
+
+def open_caster_groups(parts: list[np.ndarray]) -> list[list[int]]:
+    """Indices of ``parts`` (each a (V, 3) vertex array) grouped by shared corner positions:
+    casters that touch end up in one group (one :func:`open_volume`)."""
+    parent = list(range(len(parts)))
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    if parts:
+        points = np.concatenate([np.asarray(v, dtype=np.float64).reshape(-1, 3) for v in parts])
+        owner = np.concatenate([np.full(len(v), i) for i, v in enumerate(parts)])
+        _, point = np.unique(points, axis=0, return_inverse=True)
+        point = point.reshape(-1)
+        first = np.full(point.max() + 1, -1)
+        for p, o in zip(point.tolist(), owner.tolist(), strict=True):
+            if first[p] < 0:
+                first[p] = o
+            else:
+                ra, rb = root(first[p]), root(o)
+                if ra != rb:
+                    parent[max(ra, rb)] = min(ra, rb)
+    groups: dict[int, list[int]] = {}
+    for i in range(len(parts)):
+        groups.setdefault(root(i), []).append(i)
+    return list(groups.values())
 
 
 def _contour_edges(faces: np.ndarray, lit: np.ndarray) -> np.ndarray:

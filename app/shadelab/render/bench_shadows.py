@@ -49,7 +49,7 @@ def run(quick: bool) -> dict:
                                                   shadowed.active_lights()[0])
         result["cornell_volume_triangles"] = int(sum(len(v.volume.faces) for v in volumes))
         result["cornell_casters"] = {method: sum(v.volume.method == method for v in volumes)
-                                     for method in ("silhouette", "per-triangle")}
+                                     for method in ("silhouette", "open", "per-triangle")}
         if not quick:
             for name in ("shadows", "shadows-colored"):
                 scene = load_preset(name)

@@ -20,7 +20,10 @@ import numpy as np
 from shadelab.geometry.mesh import scene_bounds
 from shadelab.geometry.silhouette import (
     ShadowVolume,
+    closed_caster,
     light_homogeneous,
+    open_caster_groups,
+    open_volume,
     shadow_volume,
     shadows_nothing,
 )
@@ -82,7 +85,9 @@ class ShadowVolumes:
     def __init__(self, ctx: moderngl.Context):
         self.ctx = ctx
         self.program = load_program(ctx, "shadow_volume")
-        self._cache: dict[tuple[int, int], CasterVolume] = {}
+        self._cache: dict[tuple, CasterVolume] = {}
+        self._closed: dict[tuple, bool] = {}  # geometry key -> closed caster?
+        self._grouping: dict[tuple, list[list[int]]] = {}  # recent groupings of open casters
         quad = np.array([[-1, -1, 1, 1], [1, -1, 1, 1], [1, 1, 1, 1],
                          [-1, -1, 1, 1], [1, 1, 1, 1], [-1, 1, 1, 1]], dtype=np.float32)
         self._quad_vbo = ctx.buffer(quad.tobytes())
@@ -93,12 +98,18 @@ class ShadowVolumes:
                 light: Light) -> list[CasterVolume]:
         """The volumes of every shadow-casting object for one light (cached). A flat caster
         with every other object on the light's side (a floor, a room's walls) is skipped: its
-        volume holds no receiver (:func:`shadows_nothing`), the stencil is the same."""
+        volume holds no receiver (:func:`shadows_nothing`), the stencil is the same.
+
+        Closed casters get their silhouette volume, transparent ones their own volume (each
+        is counted alone for its filter flag); the other open casters are grouped by shared
+        corners and each group gets one :func:`open_volume` (the union of their per-triangle
+        volumes without the sides that cancel: the same count, far less fill)."""
         offset = OFFSET_FRACTION * float(np.linalg.norm(np.ptp(
             scene_bounds([g.mesh for g in gpu_meshes]), axis=0)))
         homogeneous = light_homogeneous(light.kind, light.position, light.direction)
         out = []
         live = set()
+        grouped = []
         for gpu in gpu_meshes:
             obj = scene.objects[gpu.mesh.index] if gpu.mesh.index < len(scene.objects) else None
             if obj is None or not obj.cast_shadows:
@@ -107,21 +118,57 @@ class ShadowVolumes:
             if shadows_nothing(gpu.mesh.vertices, gpu.mesh.face_normals, homogeneous, others,
                                offset):
                 continue
+            # kt > 0: renderer.is_transparent (filtered, so counted alone)
+            if scene.materials[obj.material].kt <= 0.0 and not self._is_closed(gpu):
+                grouped.append(gpu)
+                continue
             slot = (gpu.mesh.index, light_index)
             key = (gpu.key, light_key(light), offset)
             live.add(slot)
-            cached = self._cache.get(slot)
-            if cached is None or cached.key != key:
-                if cached is not None:
-                    cached.release()
-                cached = self._upload(key, gpu.mesh.index,
-                                      shadow_volume(gpu.mesh.vertices, gpu.mesh.faces,
-                                                    homogeneous, offset))
-                self._cache[slot] = cached
-            out.append(cached)
+            out.append(self._cached(slot, key, gpu.mesh.index, lambda g=gpu: shadow_volume(
+                g.mesh.vertices, g.mesh.faces, homogeneous, offset)))
+        for group in self._groups(grouped):
+            members = [grouped[i] for i in group]
+            slot = (("open",) + tuple(g.mesh.index for g in members), light_index)
+            key = (tuple(g.key for g in members), light_key(light), offset)
+            live.add(slot)
+            out.append(self._cached(slot, key, members[0].mesh.index, lambda m=members: (
+                open_volume([(g.mesh.vertices, g.mesh.faces) for g in m], homogeneous,
+                            offset))))
         for slot in [s for s in self._cache if s[1] == light_index and s not in live]:
             self._cache.pop(slot).release()
         return out
+
+    def _cached(self, slot: tuple, key: tuple, object_index: int, build) -> CasterVolume:
+        """The volume in ``slot`` if it was built for ``key``, else ``build()`` uploaded."""
+        cached = self._cache.get(slot)
+        if cached is None or cached.key != key:
+            if cached is not None:
+                cached.release()
+            cached = self._upload(key, object_index, build())
+            self._cache[slot] = cached
+        return cached
+
+    def _groups(self, grouped: list) -> list[list[int]]:
+        """:func:`open_caster_groups` of these meshes, memoized on their geometry keys."""
+        keys = tuple(g.key for g in grouped)
+        groups = self._grouping.get(keys)
+        if groups is None:
+            groups = open_caster_groups([g.mesh.vertices for g in grouped])
+            if len(self._grouping) > 64:
+                self._grouping.clear()
+            self._grouping[keys] = groups
+        return groups
+
+    def _is_closed(self, gpu) -> bool:
+        """Does the object's mesh make a closed caster (a silhouette volume)? Memoized."""
+        closed = self._closed.get(gpu.key)
+        if closed is None:
+            closed = closed_caster(gpu.mesh.vertices, gpu.mesh.faces) is not None
+            if len(self._closed) > 256:   # geometry edited many times: start again
+                self._closed.clear()
+            self._closed[gpu.key] = closed
+        return closed
 
     def _upload(self, key: tuple, object_index: int, volume: ShadowVolume) -> CasterVolume:
         vbo = self.ctx.buffer(volume.triangles().tobytes())
@@ -130,6 +177,12 @@ class ShadowVolumes:
         line_vbo = self.ctx.buffer(lines.tobytes() if len(lines) else bytes(32))
         line_vao = self.ctx.vertex_array(self.program, [(line_vbo, "4f", "in_position")])
         return CasterVolume(key, volume, object_index, vbo, vao, line_vbo, line_vao)
+
+    def release_volumes(self) -> None:
+        """Drop every cached volume (they are built again on the next frame)."""
+        for caster in self._cache.values():
+            caster.release()
+        self._cache.clear()
 
     def drop_lights_from(self, count: int) -> None:
         for slot in [s for s in self._cache if s[1] >= count]:
