@@ -124,8 +124,8 @@ def scenario_translate(ctx, state, out: dict) -> None:
     before = _mask_stats(_viewport_image(ctx, state, "before"))
     from shadelab.ui.app import running_viewer
 
-    height = running_viewer().viewport.panes["main"].size[1]
-    out["pixel_size"] = gizmos.pixel_size_at(state, (0.0, 0.0, 0.0), height)
+    width, height = running_viewer().viewport.panes["main"].size
+    out["pixel_size"] = gizmos.pixel_size_at(state, (0.0, 0.0, 0.0), height, width)
     ctx.window_focus("//Objects")
     ctx.set_ref("//Objects")
     ctx.item_open("object0/###obj")

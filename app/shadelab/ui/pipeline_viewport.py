@@ -13,6 +13,7 @@ import numpy as np
 from imgui_bundle import imgui
 
 from shadelab.scene.preset import clone_scene
+from shadelab.ui import presenter
 from shadelab.ui.pipelines import (
     LABELS,
     OFFLINE,
@@ -83,7 +84,9 @@ def draw(viewer, display_size: tuple[int, int]) -> bool:
         label(draw_list, imgui.ImVec2(x + 8, origin.y + display_size[1] - 28), LABELS[other])
     if name == "raytrace" and view.ray_tree is not None:
         draw_ray_tree(state, draw_list, origin, display_size)
-    label(draw_list, imgui.ImVec2(origin.x + 8, origin.y + 8), status_line(state))
+    # wrapped to the viewport, left of the fps readout (presenter fonts made them overlap)
+    label(draw_list, imgui.ImVec2(origin.x + 8, origin.y + 8), status_line(state),
+          max(display_size[0] - 16 - presenter.readout_width(state), 80.0))
     if clicked is not None:
         pick_ray_tree(state, name, clicked, display_size)
     if state.screenshot_requested:

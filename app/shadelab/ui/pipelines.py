@@ -313,11 +313,13 @@ def shooter_lines(polygon: np.ndarray) -> np.ndarray:
     return out.reshape(-1, 6)
 
 
-def label(draw_list, pos, text: str) -> None:
-    size = imgui.calc_text_size(text)
+def label(draw_list, pos, text: str, wrap: float = -1.0) -> None:
+    """White text on a dark box; wrapped at ``wrap`` pixels when given (> 0)."""
+    size = imgui.calc_text_size(text, False, wrap)
     draw_list.add_rect_filled(imgui.ImVec2(pos.x - 4, pos.y - 2),
                               imgui.ImVec2(pos.x + size.x + 4, pos.y + size.y + 2), 0xB0000000)
-    draw_list.add_text(pos, 0xFFFFFFFF, text)
+    draw_list.add_text(imgui.get_font(), imgui.get_font_size(), pos, 0xFFFFFFFF, text,
+                       max(wrap, 0.0))
 
 
 def status_line(state: AppState) -> str:

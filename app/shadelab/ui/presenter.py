@@ -201,30 +201,54 @@ def caption_text(state: AppState) -> str:
     return f"{equation}\n{mode}  -  Tab: panels"
 
 
+def caption_height(text: str, width: float, scale: float) -> float:
+    """Height of the caption band for ``text`` wrapped to ``width`` pixels (0 if no text)."""
+    if not text:
+        return 0.0
+    pad = 10.0 * scale / 1.4
+    imgui.push_font(None, imgui.get_style().font_size_base * scale)
+    try:  # measured at the size it is drawn at (glyph advances do not scale exactly)
+        text_size = imgui.calc_text_size(text, False, max(width - 2 * pad, 50.0))
+    finally:
+        imgui.pop_font()
+    return text_size.y + 2.5 * pad
+
+
 def draw_caption(draw, text: str, origin, size, scale: float) -> None:
     """Large caption at the viewport's bottom, wrapped to its width, on a dark band."""
     if not text:
         return
-    font = imgui.get_font()
-    font_size = imgui.get_font_size() * scale
     pad = 10.0 * scale / 1.4
     wrap = max(size[0] - 2 * pad, 50.0)
-    text_size = imgui.calc_text_size(text, False, wrap / scale) * scale
-    x, y = origin.x + pad, origin.y + size[1] - text_size.y - 2 * pad
-    draw.add_rect_filled(imgui.ImVec2(origin.x, y - pad / 2),
-                         imgui.ImVec2(origin.x + size[0], origin.y + size[1]), 0xA0000000)
-    draw.add_text(font, font_size, imgui.ImVec2(x + 1, y + 1), CAPTION_SHADOW, text, wrap)
-    draw.add_text(font, font_size, imgui.ImVec2(x, y), CAPTION_COLOR, text, wrap)
+    height = caption_height(text, size[0], scale)
+    imgui.push_font(None, imgui.get_style().font_size_base * scale)
+    try:
+        font, font_size = imgui.get_font(), imgui.get_font_size()
+        x, y = origin.x + pad, origin.y + size[1] - height + pad
+        draw.add_rect_filled(imgui.ImVec2(origin.x, origin.y + size[1] - height),
+                             imgui.ImVec2(origin.x + size[0], origin.y + size[1]), 0xA0000000)
+        draw.add_text(font, font_size, imgui.ImVec2(x + 1, y + 1), CAPTION_SHADOW, text, wrap)
+        draw.add_text(font, font_size, imgui.ImVec2(x, y), CAPTION_COLOR, text, wrap)
+    finally:
+        imgui.pop_font()
+
+
+def fps_text(redrawn: bool) -> str:
+    fps = imgui.get_io().framerate
+    return f"{fps:5.1f} fps  {1000.0 / max(fps, 1e-6):5.1f} ms" + ("  redrawn" if redrawn else "")
+
+
+def readout_width(state: AppState) -> float:
+    """Screen width the fps readout takes at the viewport's top right (0 when hidden): the
+    pipeline status line wraps before it instead of running under it."""
+    return imgui.calc_text_size(fps_text(True)).x + 24.0 if state.show_fps else 0.0
 
 
 def draw_viewport_extras(state: AppState, origin, size, redrawn: bool) -> None:
     """Caption and fps readout over the viewport image (origin: its top-left, screen)."""
     draw = imgui.get_window_draw_list()
     if state.show_fps:
-        io = imgui.get_io()
-        fps = io.framerate
-        text = f"{fps:5.1f} fps  {1000.0 / max(fps, 1e-6):5.1f} ms" \
-               + ("  redrawn" if redrawn else "")
+        text = fps_text(redrawn)
         width = imgui.calc_text_size(text).x
         pos = imgui.ImVec2(origin.x + size[0] - width - 8, origin.y + 4)
         draw.add_rect_filled(imgui.ImVec2(pos.x - 4, pos.y - 2),
