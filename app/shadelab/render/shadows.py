@@ -88,6 +88,7 @@ class ShadowVolumes:
         self._cache: dict[tuple, CasterVolume] = {}
         self._closed: dict[tuple, bool] = {}  # geometry key -> closed caster?
         self._grouping: dict[tuple, list[list[int]]] = {}  # recent groupings of open casters
+        self._skips: dict[tuple, list[bool]] = {}  # recent shadows_nothing answers
         quad = np.array([[-1, -1, 1, 1], [1, -1, 1, 1], [1, 1, 1, 1],
                          [-1, -1, 1, 1], [1, 1, 1, 1], [-1, 1, 1, 1]], dtype=np.float32)
         self._quad_vbo = ctx.buffer(quad.tobytes())
@@ -110,13 +111,10 @@ class ShadowVolumes:
         out = []
         live = set()
         grouped = []
-        for gpu in gpu_meshes:
+        skipped = self._skipped(gpu_meshes, light, homogeneous, offset)
+        for position, gpu in enumerate(gpu_meshes):
             obj = scene.objects[gpu.mesh.index] if gpu.mesh.index < len(scene.objects) else None
-            if obj is None or not obj.cast_shadows:
-                continue
-            others = [g.bounds for g in gpu_meshes if g is not gpu]
-            if shadows_nothing(gpu.mesh.vertices, gpu.mesh.face_normals, homogeneous, others,
-                               offset):
+            if obj is None or not obj.cast_shadows or skipped[position]:
                 continue
             # kt > 0: renderer.is_transparent (filtered, so counted alone)
             if scene.materials[obj.material].kt <= 0.0 and not self._is_closed(gpu):
@@ -138,6 +136,21 @@ class ShadowVolumes:
         for slot in [s for s in self._cache if s[1] == light_index and s not in live]:
             self._cache.pop(slot).release()
         return out
+
+    def _skipped(self, gpu_meshes, light: Light, homogeneous: np.ndarray,
+                 offset: float) -> list[bool]:
+        """:func:`shadows_nothing` of each mesh for this light, memoized on the light and
+        every mesh's geometry (the receivers' boxes): it runs again only after an edit."""
+        key = (tuple(g.key for g in gpu_meshes), light_key(light), offset)
+        skipped = self._skips.get(key)
+        if skipped is None:
+            skipped = [shadows_nothing(gpu.mesh.vertices, gpu.mesh.face_normals, homogeneous,
+                                       [g.bounds for g in gpu_meshes if g is not gpu], offset)
+                       for gpu in gpu_meshes]
+            if len(self._skips) > 64:
+                self._skips.clear()
+            self._skips[key] = skipped
+        return skipped
 
     def _cached(self, slot: tuple, key: tuple, object_index: int, build) -> CasterVolume:
         """The volume in ``slot`` if it was built for ``key``, else ``build()`` uploaded."""
@@ -179,10 +192,13 @@ class ShadowVolumes:
         return CasterVolume(key, volume, object_index, vbo, vao, line_vbo, line_vao)
 
     def release_volumes(self) -> None:
-        """Drop every cached volume (they are built again on the next frame)."""
+        """Drop every cached volume and memoized answer (built again on the next frame)."""
         for caster in self._cache.values():
             caster.release()
         self._cache.clear()
+        self._skips.clear()
+        self._grouping.clear()
+        self._closed.clear()
 
     def drop_lights_from(self, count: int) -> None:
         for slot in [s for s in self._cache if s[1] >= count]:
