@@ -34,3 +34,8 @@ def focus_windows(windows, focus: str) -> list[str]:
         if window.dock_space_name in chosen:
             window.focus_window_at_next_frame = window is chosen[window.dock_space_name]
     return [w.label for w in chosen.values()]
+
+def plot_size(height_lines: float, width: float = -1.0):
+    """An ImPlot frame ``height_lines`` text lines high (full width by default): plots grow
+    with the font, so presenter mode's large labels and ticks keep room for the curve."""
+    return imgui.ImVec2(width, height_lines * imgui.get_text_line_height_with_spacing())

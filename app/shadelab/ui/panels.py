@@ -25,7 +25,7 @@ from shadelab.scene.model import (
 from shadelab.scene.preset import list_presets
 from shadelab.shading import reference
 from shadelab.ui import dialogs
-from shadelab.ui.layout import same_line_if_fits
+from shadelab.ui.layout import plot_size, same_line_if_fits
 from shadelab.ui.ranges import field_slider, intensity_range
 from shadelab.ui.state import COMPARE_LABELS, AppState
 
@@ -235,7 +235,8 @@ def attenuation_curve(state: AppState, light: Light, samples: int = 200):
 
 def _draw_attenuation_plot(state: AppState, index: int, light: Light) -> None:
     d, f = attenuation_curve(state, light)
-    if implot.begin_plot(f"f_att(d)##{index}", imgui.ImVec2(-1, 170)):
+    if implot.begin_plot(f"f_att(d)##{index}", plot_size(9.5),
+                          implot.Flags_.no_legend):
         implot.setup_axes("d (scene units)", "f_att",
                           implot.AxisFlags_.auto_fit, implot.AxisFlags_.auto_fit)
         if light.attenuation == "inverse_square":

@@ -291,6 +291,7 @@ def draw_panel(state) -> bool:
 
 def _draw_matrix(view: RadiosityView, i: int, imgui, implot) -> None:
     from shadelab.radiosity.formfactors import heatmap_data
+    from shadelab.ui.layout import plot_size
 
     n = len(view.patches)
     if view.rows_done < n:
@@ -319,7 +320,7 @@ def _draw_matrix(view: RadiosityView, i: int, imgui, implot) -> None:
     sums = data["row_sums"]
     imgui.text(f"row sums: min {sums.min():.4f}, mean {sums.mean():.4f}, max {sums.max():.4f}"
                f" (1 in a closed scene); patch {i}: {sums[i]:.4f}")
-    if implot.begin_plot("row sums of F", imgui.ImVec2(-1, 160), implot.Flags_.no_legend):
+    if implot.begin_plot("row sums of F", plot_size(9.0), implot.Flags_.no_legend):
         implot.setup_axes("patch i", "sum_j F_ij", implot.AxisFlags_.auto_fit,
                           implot.AxisFlags_.auto_fit)
         implot.plot_line("row sum", np.arange(n, dtype=np.float64), sums.astype(np.float64))

@@ -20,6 +20,7 @@ from shadelab.scene.model import (
     RaytraceSettings,
 )
 from shadelab.ui import pipelines
+from shadelab.ui.layout import plot_size
 from shadelab.ui.state import AppState
 
 ERROR_COLOR = imgui.ImVec4(1.0, 0.35, 0.3, 1.0)
@@ -209,7 +210,7 @@ def _draw_residual_plot(view) -> None:
     residual = np.asarray(h["residual"], np.float64)
     y, label = (unshot, "unshot energy") if np.isnan(residual).all() else (residual, "residual")
     keep = np.isfinite(y) & (y > 0)
-    if implot.begin_plot("radiosity convergence", imgui.ImVec2(-1, 200)):
+    if implot.begin_plot("radiosity convergence", plot_size(11.0)):
         implot.setup_axes("shot / iteration", label, implot.AxisFlags_.auto_fit,
                           implot.AxisFlags_.auto_fit)
         implot.setup_axis_scale(implot.ImAxis_.y1, implot.Scale_.log10)

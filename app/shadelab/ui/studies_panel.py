@@ -12,6 +12,7 @@ import numpy as np
 from imgui_bundle import imgui, implot
 
 from shadelab.ui import panels
+from shadelab.ui.layout import plot_size
 from shadelab.ui.state import AppState
 from shadelab.ui.studies import (
     StudyRun,
@@ -24,7 +25,7 @@ from shadelab.ui.studies import (
 )
 
 SPINNER = "|/-\\"
-PLOT_HEIGHT = 250
+PLOT_LINES = 14.0   # plot height in text lines (grows with the font)
 TABLE_HEIGHT = 150
 FRONT_COLOR = imgui.ImVec4(0.85, 0.85, 0.85, 0.9)
 
@@ -61,7 +62,7 @@ def _wrapped(text: str, color=None) -> None:
 
 def _draw_chart(table, front: bool) -> int:
     """The table's chart; returns the number of points drawn."""
-    if not implot.begin_plot(f"{table.title}##study", imgui.ImVec2(-1, PLOT_HEIGHT)):
+    if not implot.begin_plot(f"{table.title}##study", plot_size(PLOT_LINES)):
         return 0
     drawn = 0
     implot.setup_axes(table.x, table.y, implot.AxisFlags_.auto_fit, implot.AxisFlags_.auto_fit)
