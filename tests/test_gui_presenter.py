@@ -61,7 +61,9 @@ def test_lesson_walks_forward_and_back(bigdisplay, tmp_path):
     assert r["captions"] == [s.caption for s in lesson.steps]
     assert r["indices"] == list(range(len(lesson.steps)))
     assert r["after_page_up"] == len(lesson.steps) - 2
-    assert r["step1_light_enabled"] is False and r["step1_shadows"] == "none"
+    assert r["toggles"] == [sorted(s.show) for s in lesson.steps]
+    assert any(s.show for s in lesson.steps)
+    assert r["ambient_light_enabled"] is False and r["ambient_shadows"] == "none"
     assert r["errors"] == [""] * len(lesson.steps)
 
 
@@ -175,7 +177,9 @@ def scenario_lesson_walk(ctx, state, out: dict) -> None:
     state.lesson = LessonRun(load_lesson("phong-to-radiosity"))
     go_to(state, 0)
     ctx.yield_(3)
-    presets, captions, indices, errors = [], [], [], []
+    from shadelab.ui.lesson_file import SHOW_TOGGLES
+
+    presets, captions, indices, errors, toggles = [], [], [], [], []
     for i in range(len(state.lesson.lesson.steps)):
         if i:
             ctx.key_press(imgui.Key.page_down)
@@ -184,16 +188,20 @@ def scenario_lesson_walk(ctx, state, out: dict) -> None:
         captions.append(state.lesson.step.caption)
         indices.append(state.lesson.index)
         errors.append(state.error)
+        toggles.append(sorted(name for name, attr in SHOW_TOGGLES.items()
+                              if getattr(state, attr)))
+        if state.lesson.step.title == "Ambient light":   # the light is off: Ia ka alone
+            out["ambient_light_enabled"] = state.scene.lights[0].enabled
+            out["ambient_shadows"] = state.scene.render.shadows
         if i == 0:
-            out["step1_light_enabled"] = state.scene.lights[0].enabled
-            out["step1_shadows"] = state.scene.render.shadows
             capture(ctx, str(Path(OUT_DIR) / "lesson.png"))
     ctx.key_press(imgui.Key.page_down)  # past the end: stays on the last step
     ctx.yield_(2)
     ctx.key_press(imgui.Key.page_up)
     ctx.yield_(3)
     out["after_page_up"] = state.lesson.index
-    out.update(presets=presets, captions=captions, indices=indices, errors=errors)
+    out.update(presets=presets, captions=captions, indices=indices, errors=errors,
+               toggles=toggles)
 
 
 def scenario_gizmo_drag(ctx, state, out: dict) -> None:

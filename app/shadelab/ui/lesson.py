@@ -11,6 +11,8 @@ A lesson is a TOML file in ``presets/lessons/`` (or a path)::
     set = ["lights.0.enabled=false"]   # --set overrides
     pipeline = "phong"             # optional; a pipeline the viewer lacks is skipped
     focus = "Materials"            # optional; panels brought to the front (comma-separated)
+    show = ["compare"]             # optional; view toggles on for this step (compare, diff,
+                                   # normals, wireframe, patches), the others off
 
 Loading a lesson checks every step (its preset loads with its overrides) so a typo fails at
 start with one line, not in front of the class at step 7.
@@ -22,6 +24,7 @@ from shadelab.errors import ShadeLabError
 
 # The file format and the walk (data only), re-exported where the viewer has always found them
 from shadelab.ui.lesson_file import (  # noqa: F401
+    SHOW_TOGGLES,
     STEP_KEYS,
     Lesson,
     LessonRun,
@@ -53,6 +56,8 @@ def go_to(state, index: int) -> bool:
     state.replace_scene(scene, step.preset, new_file=True)
     state.pending_open = ""
     apply_pipeline(state, step.pipeline)
+    for name, attr in SHOW_TOGGLES.items():
+        setattr(state, attr, name in step.show)
     if step.focus:
         state.focus_request = step.focus
     state.error, state.status = "", f"lesson step {index + 1}/{len(run.lesson.steps)}: " \

@@ -11,7 +11,11 @@ from shadelab.errors import ShadeLabError
 from shadelab.scene.model import Scene
 from shadelab.scene.preset import load_preset, read_toml
 
-STEP_KEYS = {"title", "caption", "preset", "set", "pipeline", "focus"}
+STEP_KEYS = {"title", "caption", "preset", "set", "pipeline", "focus", "show"}
+# View toggles a step may switch on (every other one is off while the step shows):
+# name -> the AppState field it sets
+SHOW_TOGGLES = {"compare": "compare", "diff": "diff_enabled", "normals": "show_normals",
+                "wireframe": "show_wireframe", "patches": "radiosity_patches"}
 
 
 def lessons_dir() -> Path:
@@ -32,6 +36,7 @@ class Step:
     set: list[str] = field(default_factory=list)
     pipeline: str = ""
     focus: str = ""
+    show: list[str] = field(default_factory=list)   # SHOW_TOGGLES names
 
 
 @dataclass
@@ -76,11 +81,19 @@ def load_lesson(name_or_path: str, check: bool = True) -> Lesson:
         overrides = item.get("set", [])
         if not isinstance(overrides, list) or not all(isinstance(s, str) for s in overrides):
             raise ShadeLabError(f"{where}: steps[{i}]: 'set' must be a list of KEY=VALUE strings")
+        show = item.get("show", [])
+        if not isinstance(show, list) or not all(isinstance(v, str) for v in show):
+            raise ShadeLabError(f"{where}: steps[{i}]: 'show' must be a list of names")
+        bad = [v for v in show if v not in SHOW_TOGGLES]
+        if bad:
+            raise ShadeLabError(f"{where}: steps[{i}]: show: unknown '{bad[0]}' "
+                                f"(expected {', '.join(SHOW_TOGGLES)})")
         preset = item["preset"]
         if not Path(preset).is_absolute() and preset.endswith(".toml"):
             preset = str(path.parent / preset)  # a preset file next to the lesson
         steps.append(Step(item["title"], item["caption"], preset, list(overrides),
-                          str(item.get("pipeline", "")), str(item.get("focus", ""))))
+                          str(item.get("pipeline", "")), str(item.get("focus", "")),
+                          list(show)))
     lesson = Lesson(str(raw.get("name", path.stem)), steps, str(path))
     if check:
         for i, step in enumerate(lesson.steps):

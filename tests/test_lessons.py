@@ -1,0 +1,75 @@
+"""Lesson files: the shipped lesson loads and covers the lecture's slides in order, a broken
+lesson is one line naming the step and the key, and a step sets exactly its view toggles."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from shadelab.errors import ShadeLabError
+from shadelab.scene import load_preset
+from shadelab.ui.lesson import SHOW_TOGGLES, LessonRun, go_to, list_lessons, load_lesson
+from shadelab.ui.state import AppState
+
+GOOD_STEP = '[[steps]]\ntitle = "Ambient"\ncaption = "I = Ia ka"\npreset = "lecture"\n'
+
+
+def test_every_shipped_lesson_loads_with_every_step_checked():
+    assert "phong-to-radiosity" in list_lessons()
+    for name in list_lessons():
+        lesson = load_lesson(name)            # check=True: each step's preset + overrides load
+        assert lesson.steps
+
+
+def test_the_lecture_lesson_walks_the_slides_in_order():
+    captions = [s.caption for s in load_lesson("phong-to-radiosity").steps]
+    order = ["Nv = sum_i Ni", "I = Ia ka", "(N . L)", "f_att", "(R . V)^n", "(N . H)^n",
+             "sum_i f_att,i", "Gouraud", "S_i", "(1 - kt)", "Ir", "rho(x, x', x'')",
+             "B_i = E_i"]
+    where = [next(i for i, c in enumerate(captions) if key in c) for key in order]
+    assert where == sorted(where), list(zip(order, where, strict=True))
+
+
+@pytest.mark.parametrize("body, message", [
+    ("", "at least one [[steps]]"),
+    (GOOD_STEP + "colour = 1\n", "unknown key 'colour'"),
+    (GOOD_STEP + 'show = ["compare", "xray"]\n', "show: unknown 'xray'"),
+    (GOOD_STEP + 'show = "compare"\n', "'show' must be a list"),
+    (GOOD_STEP.replace('"lecture"', '"no-such-preset"'), "no-such-preset"),
+    (GOOD_STEP + 'set = ["materials.plastic.kd=7"]\n', "kd"),
+])
+def test_a_broken_lesson_is_one_line_naming_what_is_wrong(tmp_path, body, message):
+    path = tmp_path / "broken.toml"
+    path.write_text('name = "x"\n' + body)
+    with pytest.raises(ShadeLabError) as info:
+        load_lesson(str(path))
+    text = str(info.value)
+    assert message in text and "\n" not in text
+
+
+def test_a_broken_lesson_on_the_command_line_exits_2_with_one_line(tmp_path):
+    path = tmp_path / "broken.toml"
+    path.write_text('name = "x"\n' + GOOD_STEP + 'show = ["xray"]\n')
+    run = subprocess.run([sys.executable, "-m", "shadelab", "view", "--lesson", str(path),
+                          "--frames", "1"], capture_output=True, text=True, timeout=120,
+                         env={"PATH": "/usr/bin:/bin", "DISPLAY": ""})
+    assert run.returncode == 2
+    assert len(run.stderr.strip().splitlines()) == 1 and "xray" in run.stderr
+
+
+def test_a_step_switches_on_its_view_toggles_and_off_the_rest(tmp_path):
+    path = tmp_path / "views.toml"
+    path.write_text('name = "v"\n' + GOOD_STEP + 'show = ["compare", "normals"]\n'
+                    + GOOD_STEP.replace("Ambient", "Plain"))
+    state = AppState.from_scene(load_preset("lecture"), "lecture")
+    state.show_wireframe = True
+    state.lesson = LessonRun(load_lesson(str(path)))
+    assert go_to(state, 0)
+    on = {name for name, attr in SHOW_TOGGLES.items() if getattr(state, attr)}
+    assert on == {"compare", "normals"}
+    assert go_to(state, 1)
+    assert not any(getattr(state, attr) for attr in SHOW_TOGGLES.values())
+    assert Path(state.lesson.step.preset).stem == "lecture"
