@@ -648,13 +648,15 @@ def camera_rays(eye, forward, right, up, tan_half, width, height, r0, r1, jitter
     return origins, dirs
 
 
-@nb.njit(cache=True, parallel=True)
+@nb.njit(cache=True)
 def camera_rays_into(origins, dirs, eye, forward, right, up, tan_half, width, height, r0, r1,
                      jitter):
-    """:func:`camera_rays` into the arrays passed ((r1 - r0) width rows each)."""
+    """:func:`camera_rays` into the arrays passed ((r1 - r0) width rows each). Serial: a
+    parallel kernel called from a cached njit function (:func:`camera_rays`) crashes when it
+    is loaded from numba's cache before any parallel kernel has started the thread pool."""
     aspect = width / height
     centre = jitter.shape[0] == 0
-    for j in nb.prange(r0, r1):
+    for j in range(r0, r1):
         for i in range(width):
             k = (j - r0) * width + i
             jx = 0.5 if centre else jitter[j - r0, i, 0]
