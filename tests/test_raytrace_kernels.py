@@ -72,3 +72,27 @@ def test_whitted_preset_images_agree():
     for step in whitted.iter_raytrace(scene, (20, 16), depth=3, ctx=ctx):
         b = step.image
     np.testing.assert_allclose(a, b, rtol=1e-6, atol=1e-7)
+
+
+def test_kernels_called_first_in_a_fresh_process_run_from_numbas_cache():
+    """The serial entry points that call other kernels (camera_rays, local_shade), each in a
+    new process, twice (the second run loads the compiled code from numba's cache): a
+    parallel kernel called from a cached serial one can crash there (numba issue 8578; a
+    parallel camera_rays_into once segfaulted this way)."""
+    import subprocess
+    import sys
+
+    script = (
+        "import numpy as np\n"
+        "from shadelab.raytrace import kernels as K\n"
+        "o, d = K.camera_rays(np.zeros(3), np.array([0, 0, 1.0]), np.array([1.0, 0, 0]),"
+        " np.array([0, 1.0, 0]), 0.5, 8, 6, 0, 6, np.zeros((0, 0, 2)))\n"
+        "assert o.shape == (48, 3) and abs(np.linalg.norm(d, axis=1) - 1).max() < 1e-12\n"
+        "s = K.local_shade(np.ones((4, 3)), np.tile([0, 1.0, 0], (4, 1)),"
+        " np.tile([0, 1.0, 0], (4, 1)), np.zeros(4, np.int64), np.ones((1, 13)),"
+        " np.zeros((0, 16)), np.ones(3), False, np.zeros((0, 4)))\n"
+        "assert s.shape == (4, 3)\n")
+    for _ in range(2):
+        run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                             timeout=300)
+        assert run.returncode == 0, run.stderr[-2000:]
