@@ -20,6 +20,7 @@ from shadelab.ui import (
     camera_control,
     compare_view,
     gizmos,
+    layout,
     lesson,
     overlays,
     panels,
@@ -196,7 +197,9 @@ class Viewer:
         state = self.state
         origin = imgui.get_cursor_screen_pos()
         avail = imgui.get_content_region_avail()
-        size = (max(int(avail.x), 16), max(int(avail.y) - 4, 16))
+        # the caption gets its own band under the image: it never hides the scene
+        band = presenter.caption_band(state, avail.x)
+        size = (max(int(avail.x), 16), max(int(avail.y - band) - 4, 16))
         if size != state.viewport_size and state.probe_pixel is not None:
             state.probe_requested = True  # the same pixel shows another point now
         state.viewport_size = size
@@ -206,7 +209,7 @@ class Viewer:
             self.draw_main(size)
         if not state.compare:
             gizmos.draw(state, origin, size)
-        presenter.draw_viewport_extras(state, origin, size, self.recorder.redrawn)
+        presenter.draw_viewport_extras(state, origin, size, self.recorder.redrawn, band)
         self.recorder.viewport_shown = True
         if state.error:
             imgui.set_cursor_pos(imgui.ImVec2(12, 40))
@@ -357,7 +360,10 @@ class Viewer:
         where = draw.__name__.removeprefix("draw_").removesuffix("_panel").strip("_") + " panel"
 
         def gui() -> None:
-            if guarded(lambda: draw(self.state), where, self.report_error):
+            layout.push_label_room()
+            edited = guarded(lambda: draw(self.state), where, self.report_error)
+            imgui.pop_item_width()
+            if edited:
                 self.state.mark_edited()
         return gui
 

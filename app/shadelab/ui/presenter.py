@@ -244,20 +244,36 @@ def readout_width(state: AppState) -> float:
     return imgui.calc_text_size(fps_text(True)).x + 24.0 if state.show_fps else 0.0
 
 
-def draw_viewport_extras(state: AppState, origin, size, redrawn: bool) -> None:
-    """Caption and fps readout over the viewport image (origin: its top-left, screen)."""
+def caption_scale(state: AppState) -> float:
+    return 1.4 if state.lesson is not None else 1.0
+
+
+def caption_band(state: AppState, width: float) -> float:
+    """Height of the caption band the viewport keeps under its image (0: no caption)."""
+    return caption_height(caption_text(state), width, caption_scale(state))
+
+
+def draw_viewport_extras(state: AppState, origin, size, redrawn: bool,
+                         band: float = 0.0) -> None:
+    """The fps readout over the viewport image (origin: its top-left, screen; in the 2x2
+    compare at the bottom right, clear of the panes' labels) and the caption in the ``band``
+    pixels under it (over the image's bottom when no band was kept)."""
     draw = imgui.get_window_draw_list()
     if state.show_fps:
         text = fps_text(redrawn)
         width = imgui.calc_text_size(text).x
-        pos = imgui.ImVec2(origin.x + size[0] - width - 8, origin.y + 4)
+        line = imgui.get_font_size()
+        y = origin.y + size[1] - line - 6 if state.compare else origin.y + 4
+        pos = imgui.ImVec2(origin.x + size[0] - width - 8, y)
         draw.add_rect_filled(imgui.ImVec2(pos.x - 4, pos.y - 2),
-                             imgui.ImVec2(pos.x + width + 4, pos.y + imgui.get_font_size() + 2),
-                             0x90000000)
+                             imgui.ImVec2(pos.x + width + 4, pos.y + line + 2), 0x90000000)
         draw.add_text(pos, 0xFFB0FFB0, text)
     caption = caption_text(state)
-    big = 1.4 if state.lesson is not None else 1.0
-    draw_caption(draw, caption, origin, size, big)
+    if band > 0:
+        draw_caption(draw, caption, imgui.ImVec2(origin.x, origin.y + size[1]),
+                     (size[0], band + 4), caption_scale(state))
+    else:
+        draw_caption(draw, caption, origin, size, caption_scale(state))
 
 
 # ---------------------------------------------------------------- Scene panel section
