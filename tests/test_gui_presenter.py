@@ -23,6 +23,9 @@ from test_gui import run_scenario  # noqa: E402
 pytestmark = pytest.mark.gui
 SIZES = {"layout_1024": (1024, 768), "layout_1920": (1920, 1080)}
 DOCK_WINDOWS = ("Scene", "Lights", "Materials", "Objects", "Equation & probe", "Offline render")
+# every panel, for the content-width check (text carries no item id: only the window's content
+# size shows a line of text that runs past the right edge)
+ALL_PANELS = DOCK_WINDOWS + ("Algorithms", "Studies", "Failure gallery", "Hemicube & F")
 
 
 @pytest.fixture(scope="module")
@@ -44,6 +47,8 @@ def test_presenter_layout_cuts_nothing_off(bigdisplay, tmp_path, name):
         if label != "Equation & probe":  # its text and table rows carry no item ids
             assert r["checked"][label] >= 3, f"{label}: too few items seen"
     assert r["clipped"] == [], f"items past their window's right edge: {r['clipped'][:8]}"
+    assert set(r["content_checked"]) == set(ALL_PANELS)
+    assert r["too_wide"] == [], f"content (text, tables) wider than the panel: {r['too_wide']}"
     # Tab: every panel hidden, the viewport fills the window and carries the caption
     assert r["hidden_visible"] == []
     assert r["presenter_viewport"][0] >= SIZES[name][0] - 2
@@ -144,6 +149,17 @@ def _check_layout(ctx, state, out: dict) -> None:
                                 round(rect.min.x), round(rect.max.x), round(inner.max.x)])
         checked[label] = count
     out["clipped"], out["checked"] = clipped, checked
+    too_wide, content_checked = [], []
+    for label in ALL_PANELS:
+        ctx.window_focus(f"//{label}")
+        ctx.yield_(4)   # the content size is measured at the end of a frame drawn in front
+        window = ctx.get_window_by_ref(f"//{label}")
+        region = window.content_region_rect
+        width = region.max.x - region.min.x
+        content_checked.append(label)
+        if window.content_size.x > width + 1.0:
+            too_wide.append([label, round(window.content_size.x), round(width)])
+    out["too_wide"], out["content_checked"] = too_wide, content_checked
     capture(ctx, str(Path(OUT_DIR) / "presenter.png"))
     ctx.key_press(imgui.Key.tab)
     ctx.yield_(5)

@@ -39,3 +39,13 @@ def plot_size(height_lines: float, width: float = -1.0):
     """An ImPlot frame ``height_lines`` text lines high (full width by default): plots grow
     with the font, so presenter mode's large labels and ticks keep room for the curve."""
     return imgui.ImVec2(width, height_lines * imgui.get_text_line_height_with_spacing())
+
+
+LABEL_SHARE = 0.42   # share of a panel's width its widgets leave to the labels on their right
+
+
+def push_label_room() -> None:
+    """Widgets in the panel about to be drawn leave ``LABEL_SHARE`` of its width to their
+    labels (ImGui's default leaves 35 %, and presenter fonts cut labels off at 1024x768).
+    Pair with ``imgui.pop_item_width()``."""
+    imgui.push_item_width(-LABEL_SHARE * imgui.get_content_region_avail().x)

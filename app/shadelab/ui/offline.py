@@ -138,7 +138,7 @@ def _show(state: AppState, key: str, caption: str, width: float) -> tuple[int, i
         x, y = int((mouse.x - origin.x) * w / width), int((mouse.y - origin.y) * w / width)
         if 0 <= x < w and 0 <= y < h:
             clicked = (x, y)
-    imgui.text(caption)
+    imgui.text_wrapped(caption)
     imgui.end_group()
     return clicked
 
@@ -162,7 +162,7 @@ def draw_ray_tree(state: AppState) -> None:
     root = state.ray_tree
     if root is None:
         return
-    imgui.text(f"ray tree of pixel {state.ray_tree_pixel} (drawn in the viewport; "
+    imgui.text_wrapped(f"ray tree of pixel {state.ray_tree_pixel} (drawn in the viewport; "
                f"total {_rgb(root.total())})")
     if imgui.small_button("Clear ray tree"):
         state.ray_tree = None
@@ -178,14 +178,14 @@ def draw_ray_tree(state: AppState) -> None:
             imgui.table_next_column()
             label = node.kind + (f" L{node.light} S={node.shadow:g}" if node.kind == "shadow"
                                  else "")
-            imgui.text("  " * depth + label)
+            imgui.text_wrapped("  " * depth + label)
             imgui.table_next_column()
-            imgui.text("miss" if node.end is None
+            imgui.text_wrapped("miss" if node.end is None
                        else object_label(state.job_scene, node.object))  # name (material)
             imgui.table_next_column()
-            imgui.text(_rgb(node.weight))
+            imgui.text_wrapped(_rgb(node.weight))
             imgui.table_next_column()
-            imgui.text(_rgb(node.contribution))
+            imgui.text_wrapped(_rgb(node.contribution))
         imgui.end_table()
 
 
@@ -249,7 +249,7 @@ def draw_offline_panel(state: AppState) -> bool:
             word = "failed"
         imgui.progress_bar(fraction, imgui.ImVec2(-1, 0),
                            f"{job.name}: {word} {work_done(latest)}")
-        imgui.text(f"elapsed {job.elapsed:.1f} s   {latest.message if latest else ''}")
+        imgui.text_wrapped(f"elapsed {job.elapsed:.1f} s   {latest.message if latest else ''}")
         target = VIEWPORT_PIPELINE.get(kind.label.split(" ")[0])
         if target is not None and imgui.small_button("Show in viewport"):
             from shadelab.ui.pipelines import set_pipeline
@@ -276,11 +276,11 @@ def draw_offline_panel(state: AppState) -> bool:
         _show(state, "job_diff", "|difference|", width)
     if state.job_compare:
         c = state.job_compare
-        imgui.text(f"RMSE {c['rmse']:.4g}  max |diff| {c['max_abs']:.4g}  "
+        imgui.text_wrapped(f"RMSE {c['rmse']:.4g}  max |diff| {c['max_abs']:.4g}  "
                    f"relative RMSE {c['relative_rmse']:.3%}")
         if "flip" in c:
             imgui.same_line()
-            imgui.text(f"FLIP {c['flip']:.4f}")
+            imgui.text_wrapped(f"FLIP {c['flip']:.4f}")
             if imgui.is_item_hovered():
                 imgui.set_tooltip("NVIDIA FLIP: the perceived difference after exposure "
                                   "(0 = identical, 1 = maximal)")

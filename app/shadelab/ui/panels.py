@@ -164,7 +164,9 @@ def draw_file_panel(state: AppState) -> bool:
         state.redo()
     imgui.end_disabled()
     if state.status:
-        imgui.text_colored(DIM_COLOR, state.status)
+        imgui.push_style_color(imgui.Col_.text, DIM_COLOR)
+        imgui.text_wrapped(state.status)           # long lesson titles wrap, never clip
+        imgui.pop_style_color()
     return False
 
 
@@ -193,7 +195,7 @@ def draw_render_panel(state: AppState) -> bool:
     _, state.show_normals = imgui.checkbox("Normals (N)", state.show_normals)
     if state.show_normals:
         _, state.normal_length = _slider("glyph length", state.normal_length, 0.005, 0.3, True)
-    changed, mode = _combo("all objects' normals", "", ("",) + NORMALS_MODES)
+    changed, mode = _combo("normals (all)", "", ("",) + NORMALS_MODES)
     if changed and mode:
         for obj in scene.objects:
             obj.normals = mode

@@ -234,6 +234,8 @@ def draw_panel(state) -> bool:
     """The "Hemicube & F" window. Returns False (it edits no scene field)."""
     from imgui_bundle import imgui, implot
 
+    from shadelab.ui.layout import same_line_if_fits
+
     if not state.gpu.attached:
         imgui.text("(no GL context yet)")
         return False
@@ -249,7 +251,8 @@ def draw_panel(state) -> bool:
     pv = state.pipeline_view
     shooter = None if pv is None else pv.stats.get("shooter_index")
     _, view.follow = imgui.checkbox("follow the shooting patch", view.follow)
-    imgui.same_line()
+    if same_line_if_fits("patch-id view (viewport)", radio=True):
+        imgui.same_line()
     _, view.patch_ids = imgui.checkbox("patch-id view (viewport)", view.patch_ids)
     if view.follow and shooter is not None and 0 <= int(shooter) < n:
         view.patch = int(shooter)
@@ -264,26 +267,27 @@ def draw_panel(state) -> bool:
         state.gpu.upload("hemicube_dF", weighted)
         view.shown = (view.key, i)
     width = imgui.get_content_region_avail().x
-    side = max(64.0, min(360.0, (width - 12) / 2))
+    style = imgui.get_style()   # two images and their borders side by side, within the panel
+    side = max(64.0, min(360.0, (width - style.item_spacing.x) / 2 - style.image_border_size))
     textures = [state.gpu.texture(name) for name in ("hemicube_ids", "hemicube_dF")]
     if view.shown is None or None in textures:   # the first hemicube is on its way
         imgui.text(f"rendering the hemicube of patch {i} ...")
         return False
-    for tex in textures:
+    for k, tex in enumerate(textures):
+        if k:
+            imgui.same_line()
         imgui.image(imgui.ImTextureRef(tex.id), imgui.ImVec2(side, side))
-        imgui.same_line()
-    imgui.new_line()
     shown = view.shown[1]
-    imgui.text(f"patch {shown} of {n}: item buffer (left), x delta form factors (right); "
+    imgui.text_wrapped(f"patch {shown} of {n}: item buffer (left), x delta form factors (right); "
                f"hemicube {view.res}x{view.res}")
     hv = view.views.get(shown, hv)
     if hv is None:
         return False
     i = shown
     sums = hv["face_sums"]
-    imgui.text("  ".join(f"{k} {v:.4f}" for k, v in sums.items()))
+    imgui.text_wrapped("  ".join(f"{k} {v:.4f}" for k, v in sums.items()))
     row_sum = float(view.F[i].sum()) if i < view.rows_done else None
-    imgui.text(f"sum over the 5 faces {hv['total']:.4f} (whole hemicube {hv['full']:.4f})"
+    imgui.text_wrapped(f"sum over the 5 faces {hv['total']:.4f} (whole hemicube {hv['full']:.4f})"
                + (f" = row sum of F {row_sum:.4f}" if row_sum is not None else ""))
     _draw_matrix(view, i, imgui, implot)
     return False
@@ -300,10 +304,11 @@ def _draw_matrix(view: RadiosityView, i: int, imgui, implot) -> None:
         return
     data = heatmap_data(view.F)
     shown, k = block_means(data["matrix"])
-    imgui.text(f"form-factor matrix F ({n}x{n}"
+    imgui.text_wrapped(f"form-factor matrix F ({n}x{n}"
                + (f", block means of {k}x{k}" if k > 1 else "") + f"), max {data['max']:.3g}")
     width = imgui.get_content_region_avail().x
-    size = max(120.0, min(width - 70, 420.0))
+    scale_width = 4.0 * imgui.get_font_size()       # the colormap scale's ticks grow with the font
+    size = max(120.0, min(width - scale_width - imgui.get_style().item_spacing.x, 420.0))
     vmax = float(np.nanmax(shown)) if shown.size else 1.0
     implot.push_colormap(implot.Colormap_.viridis)
     if implot.begin_plot("##F", imgui.ImVec2(size, size), implot.Flags_.no_legend):
@@ -315,11 +320,11 @@ def _draw_matrix(view: RadiosityView, i: int, imgui, implot) -> None:
                             implot.Point(0, 0), implot.Point(span, span))
         implot.end_plot()
     imgui.same_line()
-    implot.colormap_scale("##Fscale", 0.0, vmax, imgui.ImVec2(60, size))
+    implot.colormap_scale("##Fscale", 0.0, vmax, imgui.ImVec2(scale_width, size))
     implot.pop_colormap()
     sums = data["row_sums"]
-    imgui.text(f"row sums: min {sums.min():.4f}, mean {sums.mean():.4f}, max {sums.max():.4f}"
-               f" (1 in a closed scene); patch {i}: {sums[i]:.4f}")
+    imgui.text_wrapped(f"row sums: min {sums.min():.4f}, mean {sums.mean():.4f}, "
+                       f"max {sums.max():.4f} (1 in a closed scene); patch {i}: {sums[i]:.4f}")
     if implot.begin_plot("row sums of F", plot_size(9.0), implot.Flags_.no_legend):
         implot.setup_axes("patch i", "sum_j F_ij", implot.AxisFlags_.auto_fit,
                           implot.AxisFlags_.auto_fit)

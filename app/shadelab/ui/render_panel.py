@@ -218,7 +218,7 @@ def _draw_residual_plot(view) -> None:
             implot.plot_line(label, x[keep], y[keep])
         implot.end_plot()
     shooter = view.stats.get("shooter_index")
-    imgui.text(f"{view.stats.get('patches', 0)} patches, {view.stats.get('shots', 0)} shots"
+    imgui.text_wrapped(f"{view.stats.get('patches', 0)} patches, {view.stats.get('shots', 0)} shots"
                + (f", shooting patch {shooter}" if shooter is not None else "")
                + (", form factors reused" if view.stats.get("form_factors_reused") else ""))
 
@@ -226,7 +226,7 @@ def _draw_residual_plot(view) -> None:
 def draw_ray_tree_table(state: AppState, view) -> None:
     root = view.ray_tree
     deepest = max(node.depth for _, node in root.flatten())
-    imgui.text(f"ray tree of pixel {view.ray_tree_pixel}: {sum(1 for _ in root.flatten())} "
+    imgui.text_wrapped(f"ray tree of pixel {view.ray_tree_pixel}: {sum(1 for _ in root.flatten())} "
                f"rays, depth {deepest}")
     shown = min(view.tree_depth, deepest)
     changed, shown = imgui.slider_int("show generations up to", shown, 0, max(deepest, 0))
@@ -247,12 +247,12 @@ def draw_ray_tree_table(state: AppState, view) -> None:
             imgui.table_next_column()
             label = node.kind + (f" to light {node.light}: S={node.shadow:g}"
                                  if node.kind == "shadow" else f" d{node.depth}")
-            imgui.text("  " * depth + label)
+            imgui.text_wrapped("  " * depth + label)
             imgui.table_next_column()
-            imgui.text("miss" if node.end is None
+            imgui.text_wrapped("miss" if node.end is None
                        else pipelines.object_label(view.job_scene, node.object))
             imgui.table_next_column()
-            imgui.text(", ".join(f"{float(c):.3g}" for c in node.contribution))
+            imgui.text_wrapped(", ".join(f"{float(c):.3g}" for c in node.contribution))
         imgui.end_table()
 
 

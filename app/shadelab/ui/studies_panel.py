@@ -147,19 +147,21 @@ def draw_studies_panel(state: AppState) -> bool:
     imgui.end_disabled()
     if run.running:
         spin = SPINNER[int(time.perf_counter() * 8) % len(SPINNER)]
-        imgui.text(f"{spin} running the {run.name} study "
+        imgui.text_wrapped(f"{spin} running the {run.name} study "
                    f"({'quick' if run.quick else 'full'})...  {run.elapsed:.1f} s")
     elif run.error:
         _wrapped(f"{run.name} failed: {run.error}", panels.ERROR_COLOR)
     result = run.result
     if result is None:
         if not run.running:
-            imgui.text_colored(panels.DIM_COLOR, "Press Run to measure speed against accuracy.")
+            imgui.push_style_color(imgui.Col_.text, panels.DIM_COLOR)
+            imgui.text_wrapped("Press Run to measure speed against accuracy.")
+            imgui.pop_style_color()
         return False
     tables = [("main", result), *result.extra.items()]
     done = f", done in {run.elapsed:.1f} s" if not run.running and run.name == result.name \
         else ""
-    imgui.text(f"{result.name}: {len(result.rows)} rows{done}")
+    imgui.text_wrapped(f"{result.name}: {len(result.rows)} rows{done}")
     if len(tables) > 1:
         imgui.same_line()
         imgui.text("  chart:")
@@ -197,7 +199,7 @@ def draw_gallery_panel(state: AppState) -> bool:
         imgui.text_colored(panels.DIM_COLOR, "Select a case to see what fails and why.")
         return False
     case = GALLERY[state.gallery_index]
-    imgui.text(case.name)
+    imgui.text_wrapped(case.name)
     overrides = " ".join(f"--set {o}" for o in case.overrides)
     _wrapped(f"preset {case.preset} {overrides}   method {case.method}", panels.DIM_COLOR)
     imgui.separator()
