@@ -61,6 +61,13 @@ def test_pan_moves_eye_and_target_by_the_view_height_per_viewport_height():
     np.testing.assert_allclose(cam.eye, np.array([0.0, 0.0, 5.0]) + shift, atol=1e-12)
 
 
+def test_pan_in_a_viewport_narrower_than_the_fit_aspect_follows_the_wider_view():
+    cam, height, width = _camera(), 500, 250          # aspect 0.5 < fit_aspect 1: fov widened
+    pan(cam, 50.0, 0.0, height, width)
+    per_pixel = 2.0 * 5.0 * math.tan(math.radians(30.0)) * (1.0 / 0.5) / height
+    np.testing.assert_allclose(cam.target, (-50.0 * per_pixel, 0.0, 0.0), atol=1e-12)
+
+
 @pytest.mark.parametrize("notches", [1.0, -2.0, 3.5])
 def test_zoom_scales_the_distance_by_the_step_per_notch(notches):
     cam = _camera()

@@ -73,3 +73,38 @@ def test_a_step_switches_on_its_view_toggles_and_off_the_rest(tmp_path):
     assert go_to(state, 1)
     assert not any(getattr(state, attr) for attr in SHOW_TOGGLES.values())
     assert Path(state.lesson.step.preset).stem == "lecture"
+
+
+def _edited_state() -> AppState:
+    state = AppState.from_scene(load_preset("lecture"), "lecture")
+    state.scene.materials["plastic"].kd = 0.123
+    state.mark_edited()
+    state.commit_edit()
+    assert state.dirty
+    return state
+
+
+def test_opening_or_dropping_a_lesson_file_starts_it(tmp_path):
+    from shadelab.ui import dialogs
+
+    path = tmp_path / "mine.toml"
+    path.write_text('name = "mine"\n' + GOOD_STEP + GOOD_STEP.replace('"lecture"', '"cornell"'))
+    state = AppState.from_scene(load_preset("sphere-shading"), "sphere-shading")
+    dialogs.on_drop([str(path)])
+    dialogs.take_dropped(state)
+    assert state.error == "" and state.lesson is not None
+    assert state.lesson.step is None            # the viewer shows step 1 at the frame's end
+    assert go_to(state, 0) and state.scene.name == "lecture"
+
+
+def test_a_file_that_cannot_open_is_said_at_once_without_asking_about_the_edits(tmp_path):
+    state = _edited_state()
+    broken = tmp_path / "broken.toml"
+    broken.write_text("schema_version = 1\nIa = [nan, 0, 0]\n")
+    for path in (str(broken), str(tmp_path / "missing.toml")):
+        state.error = ""
+        state.request_open(path)
+        assert state.pending_open == "" and state.error and "\n" not in state.error
+        assert state.scene.materials["plastic"].kd == pytest.approx(0.123)   # edits kept
+    state.request_open("cornell")                 # a preset that opens: asks first
+    assert state.pending_open == "cornell" and state.scene.name == "lecture"

@@ -238,7 +238,7 @@ class Viewer:
             self.drag += abs(dx) + abs(dy)
             if self.drag > camera_control.CLICK_SLOP and (dx or dy) and not gizmos.capturing():
                 camera_control.drag(camera, dx, dy, imgui.is_mouse_down(imgui.MouseButton_.left),
-                                    size[1], size[1])
+                                    size[1], size[1], size[0])
                 state.mark_edited()
         if imgui.is_item_hovered() and io.mouse_wheel:
             camera_control.zoom(camera, io.mouse_wheel)
@@ -375,6 +375,9 @@ class Viewer:
         """Shortcuts, undo snapshots, autosave, title, scripted exit."""
         state = self.state
         handle_shortcuts(state)
+        if state.lesson is not None and state.lesson.step is None \
+                and not lesson.go_to(state, 0):  # a lesson just opened (Open, drop): step 1
+            state.lesson = None                  # (its error is on the status line)
         presenter.end_frame(self)
         draw_help_overlay(state)
         scale = PRESENTER_SCALE if state.presenter else 1.0

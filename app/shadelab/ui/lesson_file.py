@@ -24,6 +24,19 @@ def lessons_dir() -> Path:
     return Path(presets_dir()) / "lessons"
 
 
+def is_lesson_file(path: str) -> bool:
+    """A ``.toml`` file with ``[[steps]]`` and no ``schema_version``: a lesson, not a preset
+    (so Open and drag-and-drop take either)."""
+    p = Path(path)
+    if p.suffix.lower() != ".toml" or not p.is_file():
+        return False
+    try:
+        raw = read_toml(p)
+    except ShadeLabError:
+        return False
+    return "steps" in raw and "schema_version" not in raw
+
+
 def list_lessons() -> list[str]:
     return sorted(p.stem for p in lessons_dir().glob("*.toml"))
 

@@ -319,19 +319,47 @@ class AppState:
         """Open a preset or add a mesh; with unsaved edits, replacing the scene asks first
         (``pending_open``, answered by :func:`shadelab.ui.dialogs.draw_discard_question`)."""
         from shadelab.geometry.mesh import MESH_SUFFIXES
+        from shadelab.ui.lesson_file import is_lesson_file, load_lesson
 
-        if self.dirty and Path(path).suffix.lower() not in MESH_SUFFIXES:
-            self.pending_open = path
-        else:
+        if not self.dirty or Path(path).suffix.lower() in MESH_SUFFIXES:
             self.open_file(path)
+            return
+        try:  # a file that cannot open is said at once: no question about the edits first
+            if is_lesson_file(path):
+                load_lesson(path)
+            else:
+                load_preset(path)
+        except ShadeLabError as exc:
+            self.error = str(exc)
+            return
+        self.pending_open = path
 
     def open_file(self, path: str) -> bool:
-        """A preset (.toml or a name) replaces the scene; a mesh file is added to it."""
+        """A preset (.toml or a name) replaces the scene, a lesson file starts its walk at the
+        first step; a mesh file is added to the scene."""
         from shadelab.geometry.mesh import MESH_SUFFIXES
+        from shadelab.ui.lesson_file import is_lesson_file
 
         if Path(path).suffix.lower() in MESH_SUFFIXES:
             return self.add_mesh(path)
+        if is_lesson_file(path):
+            return self.open_lesson(path)
         return self.open_preset(path)
+
+    def open_lesson(self, path: str) -> bool:
+        """Walk the lesson in ``path`` (PageDown / PageUp): the viewer shows its first step at
+        the frame's end (:func:`shadelab.ui.lesson.go_to`); a broken lesson is one line and
+        keeps the scene."""
+        from shadelab.ui.lesson_file import LessonRun, load_lesson
+
+        try:
+            lesson = load_lesson(path)
+        except ShadeLabError as exc:
+            self.error = str(exc)
+            return False
+        self.lesson = LessonRun(lesson)
+        self.error, self.status = "", f"lesson {lesson.name}: {len(lesson.steps)} steps"
+        return True
 
     def add_mesh(self, path: str) -> bool:
         """Add a mesh file as an object, fitted in front of the camera; errors keep the scene."""
