@@ -14,7 +14,7 @@ from shadelab.ui.jobs import available_jobs, difference
 from shadelab.ui.pipelines import object_label
 from shadelab.ui.state import AppState
 
-SIZES = (32, 64, 96, 128, 192, 256, 384, 512)
+SIZES = (32, 64, 96, 128, 192, 256, 384, 512, 768, 1024)
 SAMPLES = (1, 4, 16, 64, 256)
 
 
@@ -225,7 +225,7 @@ def draw_offline_panel(state: AppState) -> bool:
     kind = options[state.job_kind]
     if kind.make is None:
         imgui.text_colored(panels.DIM_COLOR, f"not available: {kind.reason}")
-    index = SIZES.index(state.job_size) if state.job_size in SIZES else 3
+    index = SIZES.index(state.job_size) if state.job_size in SIZES else SIZES.index(256)
     _, index = imgui.combo("Height (px)", index, [str(s) for s in SIZES])
     state.job_size = SIZES[index]
     if kind.label.startswith("Path"):

@@ -154,7 +154,7 @@ class JobState:
 
     job: JobRunner | None = None
     job_kind: int = 0
-    job_size: int = 128
+    job_size: int = 256                # offline panel image height, px
     job_spp: int = 16                 # samples per pixel (path tracer; Whitted anti-aliasing)
     job_compare: dict | None = None   # error figures vs the raster view
     job_raster: np.ndarray | None = None  # (H, W, 3) raster image the job is compared with
