@@ -382,7 +382,11 @@ EQUATION_BLINN = "I = Le + Ia ka Od + sum_i S_i f_att,i Ip,i [kd Od (N.L_i) + ks
 
 
 def _rgb(v, digits: int = 3) -> str:
-    return "(" + ", ".join(f"{float(c):.{digits}g}" for c in np.asarray(v).reshape(-1)[:3]) + ")"
+    """A 3-vector for reading: components below 1e-9 of its largest show as 0 (a unit normal
+    reads (0, 0, 1), not (3.49e-17, -4.5e-16, 1))."""
+    c = np.asarray(v, dtype=np.float64).reshape(-1)[:3]
+    tiny = 1e-9 * max(float(np.abs(c).max()) if c.size else 0.0, 1e-300)
+    return "(" + ", ".join(f"{0.0 if abs(x) < tiny else float(x):.{digits}g}" for x in c) + ")"
 
 
 def _term_row(label: str, value) -> None:
