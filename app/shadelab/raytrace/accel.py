@@ -194,6 +194,27 @@ class EmbreeAccel:
         t = np.where(hit, tfar.astype(np.float64), np.inf)
         return Hits(t, tri, u.astype(np.float64), v.astype(np.float64))
 
+    def occluder(self, faces: np.ndarray) -> Occluder:
+        """Occlusion queries against the triangles ``faces`` alone (a scene of their own)."""
+        from embreex import rtcore_scene
+        from embreex.mesh_construction import TriangleMesh
+
+        scene = rtcore_scene.EmbreeScene()
+        faces = np.asarray(faces, dtype=np.int64)
+        if len(faces):
+            TriangleMesh(scene, self.geometry.triangles[faces].astype(np.float32))
+            one = np.zeros((1, 3), np.float32)   # commit now, before any threads
+            scene.run(one, one + np.float32(1.0), query="OCCLUDED", dists=np.zeros(1, np.float32))
+
+        def query(origins, dirs, tmax):
+            n = len(origins)
+            o = np.ascontiguousarray(origins, dtype=np.float32)
+            d = np.ascontiguousarray(dirs, dtype=np.float32)
+            dists = np.ascontiguousarray(np.minimum(np.broadcast_to(tmax, (n,)), T_INF),
+                                         dtype=np.float32)
+            return _embree_run(scene, o, d, dists, "OCCLUDED", False) != -1
+        return Occluder(len(faces), query)
+
     def occluded(self, origins: np.ndarray, dirs: np.ndarray, tmax: np.ndarray,
                  everything: bool = False) -> np.ndarray:
         """True where a shadow caster (any triangle with ``everything``) lies at t < tmax."""
@@ -206,6 +227,20 @@ class EmbreeAccel:
         dists = np.ascontiguousarray(np.minimum(np.broadcast_to(tmax, (n,)), T_INF),
                                      dtype=np.float32)
         return _embree_run(target, o, d, dists, "OCCLUDED", False) != -1
+
+
+class Occluder:
+    """Occlusion queries against a subset of the scene's triangles (:meth:`EmbreeAccel.occluder`,
+    :meth:`BvhAccel.occluder`); with no triangles nothing is occluded."""
+
+    def __init__(self, count: int, query) -> None:
+        self.count, self._query = count, query
+
+    def occluded(self, origins: np.ndarray, dirs: np.ndarray, tmax: np.ndarray) -> np.ndarray:
+        """True where one of the subset's triangles lies at t < tmax."""
+        if len(origins) == 0 or self.count == 0:
+            return np.zeros(len(origins), bool)
+        return self._query(origins, dirs, tmax)
 
 
 def _misses(n: int) -> Hits:
@@ -253,6 +288,18 @@ class BvhAccel:
         tree = self._all if everything else self._casters
         return self._bvh.occluded(tree, np.ascontiguousarray(origins, np.float64),
                                   np.ascontiguousarray(dirs, np.float64), limit)
+
+    def occluder(self, faces: np.ndarray) -> Occluder:
+        """Occlusion queries against the triangles ``faces`` alone (a tree of their own)."""
+        faces = np.asarray(faces, dtype=np.int64)
+        tree = self._bvh.build(self.geometry.triangles[faces]) if len(faces) else None
+
+        def query(origins, dirs, tmax):
+            n = len(origins)
+            limit = np.minimum(np.broadcast_to(tmax, (n,)), T_INF).astype(np.float64)
+            return self._bvh.occluded(tree, np.ascontiguousarray(origins, np.float64),
+                                      np.ascontiguousarray(dirs, np.float64), limit)
+        return Occluder(len(faces), query)
 
 
 def embree_available() -> bool:

@@ -176,7 +176,7 @@ class TraceContext:
             if len(idx):
                 origin = pos[idx] + self.eps * ng[idx]
                 tmax = np.where(np.isfinite(distance[idx]), distance[idx] - self.eps, T_INF)
-                blocked = self.accel.occluded(origin, to_light[idx], tmax)
+                blocked = self.shadow_occluded(origin, to_light[idx], tmax)
                 s[idx] = np.where(blocked, 0.0, 1.0)
                 self.shadow_rays += len(idx)
                 s = self._filter_blocked(s, idx, blocked, origin, to_light[idx], tmax)
@@ -194,7 +194,7 @@ class TraceContext:
             s = np.zeros(len(pos))
             idx = np.flatnonzero(facing)
             if len(idx):
-                blocked = self.accel.occluded(origin[idx], dirs[idx], tmax[idx])
+                blocked = self.shadow_occluded(origin[idx], dirs[idx], tmax[idx])
                 s[idx] = np.where(blocked, 0.0, 1.0)
                 self.shadow_rays += len(idx)
                 s = self._filter_blocked(s, idx, blocked, origin[idx], dirs[idx], tmax[idx])
@@ -209,6 +209,32 @@ class TraceContext:
         g = self.geometry
         faces = g.object_index[g.casts_shadow]
         return bool(len(faces)) and bool(np.any(self.kt[self.object_material[faces]] > 0.0))
+
+    @cached_property
+    def _light_takers(self):
+        """The shadow casters that take light away: opaque ones and those whose kt Ot (kt for
+        the interpolated model) is below 1 in some channel. A caster that passes every
+        channel whole (clear glass: kt = 1, Ot = 1) changes no shadow ray (each crossing
+        multiplies by 1.0 exactly), so a ray only it blocks is lit, S_i = 1, without being
+        followed through it. ``None`` when every caster takes light (the accelerator's
+        caster scene answers)."""
+        g = self.geometry
+        if not self.transparent_casters:
+            return None
+        clear = g.casts_shadow & np.all(
+            self._shadow_filter[self.object_material[g.object_index]] >= 1.0, axis=1)
+        if not clear.any():
+            return None
+        return self.accel.occluder(np.flatnonzero(g.casts_shadow & ~clear))
+
+    def shadow_occluded(self, origins: np.ndarray, dirs: np.ndarray,
+                        tmax: np.ndarray) -> np.ndarray:
+        """The shadow rays' first question: is a caster that takes light away in the way?
+        (Where one is, :meth:`shadow_transmittance` follows the ray.)"""
+        takers = self._light_takers
+        if takers is None:
+            return self.accel.occluded(origins, dirs, tmax)
+        return takers.occluded(origins, dirs, tmax)
 
     def shadow_transmittance(self, origins: np.ndarray, dirs: np.ndarray,
                              tmax: np.ndarray) -> np.ndarray:

@@ -189,7 +189,7 @@ def _trace_batch_kernels(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarra
             light, point = ws.get("sk", rows, 0, np.int64), ws.get("si", rows, 0, np.int64)
             count = kernels.shadow_batch(position, geo, ctx.light_table, ctx.eps, T_INF, o32,
                                          d32, t32, light, point)
-            blocked = ctx.accel.occluded(o32[:count], d32[:count], t32[:count])
+            blocked = ctx.shadow_occluded(o32[:count], d32[:count], t32[:count])
             stats.shadow += count
             ctx.shadow_rays += count
             if ctx.transparent_casters:  # kt-filtered S_i (L, k, 3)
