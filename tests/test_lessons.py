@@ -108,3 +108,16 @@ def test_a_file_that_cannot_open_is_said_at_once_without_asking_about_the_edits(
         assert state.scene.materials["plastic"].kd == pytest.approx(0.123)   # edits kept
     state.request_open("cornell")                 # a preset that opens: asks first
     assert state.pending_open == "cornell" and state.scene.name == "lecture"
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--lesson", "phong-to-radiosity", "--step", "99"], "--step 99: expected 1 to"),
+    (["--lesson", "phong-to-radiosity", "--step", "0"], "--step 0: expected 1 to"),
+    (["--step", "3"], "--step 3: only with --lesson"),
+])
+def test_a_bad_lesson_step_exits_2_with_one_line(argv, message):
+    run = subprocess.run([sys.executable, "-m", "shadelab", "view", *argv, "--frames", "1"],
+                         capture_output=True, text=True, timeout=120,
+                         env={"PATH": "/usr/bin:/bin", "DISPLAY": ""})
+    assert run.returncode == 2
+    assert len(run.stderr.strip().splitlines()) == 1 and message in run.stderr

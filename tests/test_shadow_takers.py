@@ -16,9 +16,7 @@ BACKENDS = ["bvh"] + (["embree"] if embree_available() else [])
 
 
 def _render(scene, ctx, size=(64, 64)):
-    for step in iter_raytrace(scene, size, ctx=ctx):
-        pass
-    return step.image
+    return list(iter_raytrace(scene, size, ctx=ctx))[-1].image
 
 
 @pytest.mark.parametrize("backend", BACKENDS)

@@ -31,6 +31,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="fullscreen at the monitor's resolution (F11 toggles)")
     p.add_argument("--lesson", metavar="NAME", help="walk a lesson from presets/lessons/ "
                    "(PageDown / PageUp), e.g. phong-to-radiosity")
+    p.add_argument("--step", type=int, default=1, metavar="N",
+                   help="with --lesson: start at step N (1 = the first)")
     p.add_argument("--frames", type=int, default=0, metavar="N", help="quit after N frames")
     p.add_argument("--screenshot", metavar="PATH", help="write a PNG of the window at exit")
     p.add_argument("--compare", action="store_true", help="start in 2x2 compare mode")
@@ -198,12 +200,18 @@ def run_view(args: argparse.Namespace) -> int:
                                 f"{', '.join(PIPELINE_NAMES)}")
     run = None
     notes: list[str] = []   # a damaged autosaved session, for the status line
+    if args.step != 1 and not args.lesson:
+        raise ShadeLabError(f"--step {args.step}: only with --lesson NAME")
     if args.lesson:
         from shadelab.ui.lesson import LessonRun, load_lesson, step_scene
 
         run = LessonRun(load_lesson(args.lesson))  # every step checked: one-line error
-        scene, source, restored = step_scene(run.lesson.steps[0]), \
-            run.lesson.steps[0].preset, False
+        steps = len(run.lesson.steps)
+        if not 1 <= args.step <= steps:
+            raise ShadeLabError(f"--step {args.step}: expected 1 to {steps} "
+                                f"(lesson '{args.lesson}' has {steps} steps)")
+        first = run.lesson.steps[args.step - 1]
+        scene, source, restored = step_scene(first), first.preset, False
     else:
         scene, source, restored = load_scene(args, notes)
     from shadelab.geometry.mesh import scene_meshes
@@ -224,14 +232,14 @@ def run_view(args: argparse.Namespace) -> int:
         state.history.files[0] = state.file_meta()
     if notes:
         state.error = notes[-1]
-    if run is not None:
-        from shadelab.ui.lesson import go_to
-
-        state.lesson = run
-        go_to(state, 0)
     state.compare, state.diff_enabled = args.compare, args.diff
     state.presenter, state.show_help = args.presenter, args.help_overlay
     state.show_wireframe, state.show_normals = args.wireframe, args.normals
+    if run is not None:   # after the view flags: the step's own toggles (show = [...]) win
+        from shadelab.ui.lesson import go_to
+
+        state.lesson = run
+        go_to(state, args.step - 1)
     state.msaa = args.msaa
     options = ViewerOptions(frames=args.frames, screenshot=args.screenshot or "",
                             window_size=window, probe=probe, job=args.job or "",
