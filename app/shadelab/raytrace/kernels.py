@@ -93,7 +93,10 @@ def _lit(ip, kd, od, lam, ks, os_, spec):
     return ip * kd * od * lam + ip * ks * os_ * spec
 
 
-@nb.njit(cache=True)
+# local_shade and local_shade_into are plain Python: the parallel kernel below is entered from
+# Python only. Called from a cached serial njit function, a parallel kernel crashed a fresh
+# process that loaded both from numba's cache before any parallel kernel had started the
+# thread pool (numba issue 8578; segfault seen in a clean clone's CI run).
 def local_shade(position, normal, to_eye, mat, mats, lights, ia, blinn, shadow):
     """The lecture's I (N, 3) at N points; ``shadow`` is (L, N) S_i."""
     out = np.empty((len(position), 3))
@@ -101,14 +104,14 @@ def local_shade(position, normal, to_eye, mat, mats, lights, ia, blinn, shadow):
     return out
 
 
-@nb.njit(cache=True)
 def local_shade_into(out, position, normal, to_eye, mat, mats, lights, ia, blinn, shadow,
                      eye_sign):
     """:func:`local_shade` into ``out`` (N, 3); the vector to the eye is ``-eye_sign * to_eye``
     (pass the ray directions with ``eye_sign = 1``, so no negated copy is made). ``shadow`` is
     (L, N): :func:`local_shade_into3` with one S_i for every channel (a view, no copy)."""
+    shadow = np.asarray(shadow, dtype=np.float64)
     local_shade_into3(out, position, normal, to_eye, mat, mats, lights, ia, blinn,
-                      shadow.reshape((shadow.shape[0], shadow.shape[1], 1)), eye_sign)
+                      shadow.reshape((shadow.shape[0], shadow.shape[1], 1)), float(eye_sign))
 
 
 @nb.njit(cache=True, parallel=True)
