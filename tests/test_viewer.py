@@ -428,3 +428,38 @@ def test_save_never_overwrites_a_shipped_preset(tmp_path, monkeypatch):
     state.preset_path = str(own)
     panels.save_here(state)
     assert asked == ["save"] and load_preset(str(own)).materials["white"].kd == 0.5
+
+
+def slow_stages(scene, size):
+    """A picklable job: a step, then a stage longer than the runner's KILL_AFTER, then more."""
+    from shadelab.progress import Progress
+    from shadelab.ui.jobs import KILL_AFTER
+
+    yield Progress(None, 0.1, "stage 1")
+    time.sleep(KILL_AFTER + 1.0)
+    yield Progress(None, 0.5, "stage 2")
+    yield Progress(None, 1.0, "stage 3")
+
+
+@pytest.mark.parametrize("kill_after", [None, 0.5])
+def test_a_soft_cancel_waits_for_the_step_a_hard_one_ends_the_worker(kill_after):
+    """A kernel warm-up is cancelled softly (kill_after=None): it stops after the stage it is
+    in, and the worker process (with the kernels it loaded) lives on."""
+    runner = JobRunner()
+    try:
+        runner.start("slow", lambda: None, call=(slow_stages, None, (1, 1)))
+        deadline = time.perf_counter() + 60.0
+        while runner.snapshot()[0] is None and time.perf_counter() < deadline:
+            time.sleep(0.01)
+        pid = runner.worker.process.pid
+        runner.cancel(kill_after=kill_after)
+        runner._thread.join(30.0)
+        assert runner.cancelled and not runner.running
+        if kill_after is None:   # stopped after stage 2, by itself: same live worker
+            assert runner.snapshot()[0].message == "stage 2" and not runner.error
+            assert runner.worker.process.is_alive() and runner.worker.process.pid == pid
+        else:                    # ended mid-stage: the worker was killed
+            assert runner.snapshot()[0].message == "stage 1"
+            assert runner.worker.process is None   # ended (a new one starts on demand)
+    finally:
+        runner.shutdown()

@@ -160,6 +160,7 @@ class JobRunner:
         self.finished = 0.0
         self.cancelled = False
         self.cancel_requested = 0.0     # perf_counter() of the last cancel
+        self.kill_after: float | None = KILL_AFTER   # of that cancel (None: never killed)
         self.version = 0                # bumps on every new Progress (the UI re-uploads then)
         self.trail: list[dict] = []     # every Progress of the job, in brief (the UI may skip some)
         self._cancel = threading.Event()
@@ -215,7 +216,8 @@ class JobRunner:
         """Relay the worker process's Progress; end it if a cancel does not land in time."""
         worker = self.worker
         while True:
-            if self._cancel.is_set() and time.perf_counter() - self.cancel_requested > KILL_AFTER:
+            if self._cancel.is_set() and self.kill_after is not None \
+                    and time.perf_counter() - self.cancel_requested > self.kill_after:
                 worker.kill()
                 self.cancelled = True
                 break
@@ -253,9 +255,14 @@ class JobRunner:
                 gen.close()
             self.finished = time.perf_counter()
 
-    def cancel(self, wait: bool = False, timeout: float = 5.0) -> None:
+    def cancel(self, wait: bool = False, timeout: float = 5.0,
+               kill_after: float | None = KILL_AFTER) -> None:
+        """Stop the job at its next Progress; a process job that has not stopped
+        ``kill_after`` seconds later has its worker ended (None: never, it stops at its next
+        step however long that takes, e.g. a kernel warm-up that must not die mid-compile)."""
         if self.running and not self._cancel.is_set():
             self.cancel_requested = time.perf_counter()
+        self.kill_after = kill_after
         self._cancel.set()
         if self.in_process and self.worker.cancel is not None:
             self.worker.cancel.set()

@@ -144,8 +144,12 @@ def poll(state: AppState, name: str, size: tuple[int, int]) -> None:
         view.key = key
         view.wanted = (name, scene_for(state, name), size)
         view.ray_tree = None
-        if view.name != "warm-up":       # (a cancelled warm-up would be killed mid-compile)
-            runner.cancel()              # no wait: the new job starts once this one stops
+        # no wait: the new job starts once this one stops; a warm-up stops at its next stage
+        # (one renderer's kernels) and is never killed mid-compile
+        if view.name == "warm-up":
+            runner.cancel(kill_after=None)
+        else:
+            runner.cancel()
     if view.wanted is not None and not runner.running and not view.paused:
         _start(state, *view.wanted)
         view.wanted = None
