@@ -96,3 +96,28 @@ def test_kernels_called_first_in_a_fresh_process_run_from_numbas_cache():
         run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
                              timeout=300)
         assert run.returncode == 0, run.stderr[-2000:]
+
+
+def test_no_serial_kernel_calls_a_parallel_one():
+    """numba issue 8578: a parallel kernel called from a cached serial njit function crashed
+    a fresh process loading both from the cache (camera_rays once, local_shade until this
+    test's time); parallel kernels are entered from Python only."""
+    import ast
+    from pathlib import Path
+
+    import shadelab
+
+    parallel, serial = set(), []
+    for path in Path(shadelab.__file__).parent.rglob("*.py"):
+        for node in ast.parse(path.read_text()).body:
+            if not isinstance(node, ast.FunctionDef):
+                continue
+            jit = [ast.unparse(d) for d in node.decorator_list if "jit" in ast.unparse(d)]
+            if jit:
+                (parallel.add(node.name) if "parallel=True" in jit[0]
+                 else serial.append((path.name, node)))
+    assert {"hit_surfaces", "local_shade_into3"} <= parallel   # the scan sees the kernels
+    calls = {(f, node.name): {ast.unparse(c.func).split(".")[-1] for c in ast.walk(node)
+                              if isinstance(c, ast.Call)} & parallel
+             for f, node in serial}
+    assert {k: v for k, v in calls.items() if v} == {}
