@@ -49,6 +49,9 @@ def test_presenter_layout_cuts_nothing_off(bigdisplay, tmp_path, name):
     assert r["clipped"] == [], f"items past their window's right edge: {r['clipped'][:8]}"
     assert set(r["content_checked"]) == set(ALL_PANELS)
     assert r["too_wide"] == [], f"content (text, tables) wider than the panel: {r['too_wide']}"
+    assert len(r["tabs"]) >= len(ALL_PANELS)
+    narrow = [t for t in r["tabs"] if t[1] < t[2] - 1]
+    assert narrow == [], f"dock tabs shrunk below their title (or '{TAB_WORD}'): {narrow}"
     # Tab: every panel hidden, the viewport fills the window and carries the caption
     assert r["hidden_visible"] == []
     assert r["presenter_viewport"][0] >= SIZES[name][0] - 2
@@ -108,6 +111,9 @@ def test_file_dialogs_stubbed_and_a_panel_error_closes_its_scopes(bigdisplay, tm
     assert "boom" in r["panel_error"] and r["frames_after_error"] >= 5
 
 
+TAB_WORD = "Materials"   # (shadelab.ui.app.TAB_WORD; the pytest side imports no GUI)
+
+
 # ---------------------------------------------------------------- scenario side
 
 
@@ -160,6 +166,20 @@ def _check_layout(ctx, state, out: dict) -> None:
         if window.content_size.x > width + 1.0:
             too_wide.append([label, round(window.content_size.x), round(width)])
     out["too_wide"], out["content_checked"] = too_wide, content_checked
+    from shadelab.ui.app import TAB_WORD
+
+    word = imgui.calc_text_size(TAB_WORD).x
+    tabs, seen = [], set()
+    for label in ALL_PANELS:   # dock tabs: as wide as their title or the word, then scroll
+        node = ctx.get_window_by_ref(f"//{label}").dock_node
+        if node is None or node.tab_bar is None or node.id_ in seen:
+            continue
+        seen.add(node.id_)
+        for k in range(node.tab_bar.tabs.size()):
+            tab = node.tab_bar.tabs[k]
+            tabs.append([tab.window.name if tab.window else "?", round(tab.width),
+                         round(min(tab.content_width, word))])
+    out["tabs"] = tabs
     capture(ctx, str(Path(OUT_DIR) / "presenter.png"))
     ctx.key_press(imgui.Key.tab)
     ctx.yield_(5)

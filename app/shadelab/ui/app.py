@@ -49,6 +49,9 @@ WINDOW_BG = imgui.ImVec4(0.06, 0.06, 0.06, 1.0)  # the dark theme's panel color,
 # ---------------------------------------------------------------- shortcuts
 
 
+TAB_WORD = "Materials"   # dock tabs shrink no narrower than this word, then scroll
+
+
 def _set(attr: str, value) -> Callable[[AppState], None]:
     def action(state: AppState) -> None:
         setattr(state.scene.render, attr, value)
@@ -384,6 +387,10 @@ class Viewer:
         style = imgui.get_style()
         if style.font_scale_main != scale:  # only on change: a new scale re-bakes glyphs
             style.font_scale_main = scale
+        # dock tabs shrink no narrower than a word ("Materials"), then scroll: at 1024x768
+        # in presenter mode they had shrunk to "Mate..." and "O..."
+        style.tab_min_width_shrink = imgui.calc_text_size(TAB_WORD).x \
+            + 2.0 * style.frame_padding.x + imgui.get_font_size()   # + the close button
         if state.edit_pending and not imgui.is_any_item_active() and not gizmos.capturing():
             state.commit_edit()
         if self.options.autosave:
