@@ -210,9 +210,11 @@ class Viewer:
             compare_view.draw_compare(self, size)
         else:
             self.draw_main(size)
+        # the caption and fps readout first: nothing the gizmo does to the draw list's clip
+        # rect can hide them
+        presenter.draw_viewport_extras(state, origin, size, self.recorder.redrawn, band)
         if not state.compare:
             gizmos.draw(state, origin, size)
-        presenter.draw_viewport_extras(state, origin, size, self.recorder.redrawn, band)
         self.recorder.viewport_shown = True
         if state.error:
             imgui.set_cursor_pos(imgui.ImVec2(12, 40))

@@ -87,7 +87,11 @@ def draw(state: AppState, origin, size: tuple[int, int]) -> bool:
             else GLYPH_OFF_COLOR
         _draw_glyph(draw_list, project, origin, light, color, scale, span)
     light = state.scene.lights[selected]
-    if light.kind == "directional":
+    forward = np.subtract(cam.target, cam.eye) / span
+    depth = float(np.dot(np.subtract(light.position, cam.eye), forward))
+    if light.kind == "directional" or (depth <= cam.near and not _using):
+        # (a light beside or behind the eye: ImGuizmo returns early there and left its clip
+        # rect on the window's draw list, which hid the lesson caption drawn after it)
         _using = False
         return False
     GIZMO.set_drawlist(draw_list)
