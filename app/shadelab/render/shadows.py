@@ -334,9 +334,7 @@ class ShadowVolumes:
                 caster.line_vao.render(moderngl.LINES)
 
     def release(self) -> None:
-        for caster in self._cache.values():
-            caster.release()
-        self._cache.clear()
+        self.release_volumes()
         self._quad_vao.release()
         self._quad_vbo.release()
         self.program.release()
