@@ -214,13 +214,16 @@ def caption_height(text: str, width: float, scale: float) -> float:
     return text_size.y + 2.5 * pad
 
 
-def draw_caption(draw, text: str, origin, size, scale: float) -> None:
-    """Large caption at the viewport's bottom, wrapped to its width, on a dark band."""
+def draw_caption(draw, text: str, origin, size, scale: float,
+                 height: float | None = None) -> None:
+    """Large caption at the bottom of the ``size`` rect at ``origin``, wrapped to its width,
+    on a dark band ``height`` high (:func:`caption_height`, measured here when not given)."""
     if not text:
         return
     pad = 10.0 * scale / 1.4
     wrap = max(size[0] - 2 * pad, 50.0)
-    height = caption_height(text, size[0], scale)
+    if height is None:
+        height = caption_height(text, size[0], scale)
     imgui.push_font(None, imgui.get_style().font_size_base * scale)
     try:
         font, font_size = imgui.get_font(), imgui.get_font_size()
@@ -271,7 +274,7 @@ def draw_viewport_extras(state: AppState, origin, size, redrawn: bool,
     caption = caption_text(state)
     if band > 0:
         draw_caption(draw, caption, imgui.ImVec2(origin.x, origin.y + size[1]),
-                     (size[0], band + 4), caption_scale(state))
+                     (size[0], band + 4), caption_scale(state), band)  # measured once a frame
     else:
         draw_caption(draw, caption, origin, size, caption_scale(state))
 
