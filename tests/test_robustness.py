@@ -178,6 +178,8 @@ def test_every_number_in_the_field_table_has_a_finite_range():
     ("lights.0.c3=1e200", "expected a number in [0, 1e+12]"),
     ("camera.near=inf", "not finite"),
     ("Ia=nan,0,0", "not finite"),
+    ("camera.fit_aspect=-1", "key 'camera.fit_aspect': expected a number in [0, 8]"),
+    ("camera.fit_aspect=inf", "not finite"),
 ])
 def test_numbers_outside_the_finite_range_are_refused(tmp_path, capsys, setting, expected):
     argv = ["raytrace", _preset(tmp_path, GOOD), "-o", str(tmp_path / "x.png"),
