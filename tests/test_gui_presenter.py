@@ -95,6 +95,14 @@ def test_gizmo_drag_moves_the_light_by_the_dragged_distance(bigdisplay, tmp_path
     assert r["undone"] == pytest.approx(r["before"])
 
 
+def test_a_lesson_is_picked_and_stepped_from_the_scene_panel(bigdisplay, tmp_path):
+    r = _run("lesson_panel", bigdisplay, tmp_path)
+    assert r["picked"] == ["phong-to-radiosity", 0, "sphere-shading"]   # step 1 shown
+    assert r["after_next"] == 1 and r["scene_after_next"] == "lecture"
+    assert r["after_prev"] == 0
+    assert r["after_none"] is None and r["scene_after_none"] == "sphere-shading"
+
+
 def test_preset_load_undo_and_overlays_cleared(bigdisplay, tmp_path):
     r = _run("hygiene", bigdisplay, tmp_path)
     assert r["loaded"] == "cornell" and r["undone"] == "lecture" and r["redone"] == "cornell"
@@ -288,6 +296,39 @@ def scenario_gizmo_drag(ctx, state, out: dict) -> None:
     state.undo()
     ctx.yield_(2)
     out["undone"] = list(state.scene.lights[0].position)
+
+
+def scenario_lesson_panel(ctx, state, out: dict) -> None:
+    """No --lesson: the Scene panel's Lesson combo starts one, the buttons under the
+    viewport's caption step it (they stay in reach whichever panel a step brings forward)."""
+    from imgui_bundle import imgui
+
+    state.presenter = True
+    ctx.yield_(5)
+    ctx.window_focus("//Scene")
+    ctx.set_ref("//Scene")
+    ctx.item_click("Lesson")
+    # the first step brings the Objects panel forward, hiding the Scene tab under the cursor:
+    # no hover check after the click
+    ctx.item_click("//$FOCUSED/phong-to-radiosity", 0,
+                   imgui.test_engine.TestOpFlags_.no_check_hovered_id)
+    ctx.yield_(4)
+    run = state.lesson
+    out["picked"] = [Path(run.lesson.path).stem, run.index, state.scene.name]
+    ctx.set_ref("//Viewport")
+    ctx.item_click("Next > (PgDn)")
+    ctx.yield_(3)
+    out["after_next"], out["scene_after_next"] = state.lesson.index, state.scene.name
+    ctx.item_click("< Prev (PgUp)")
+    ctx.yield_(3)
+    out["after_prev"] = state.lesson.index
+    capture(ctx, str(Path(OUT_DIR) / "lesson-buttons.png"))
+    ctx.window_focus("//Scene")
+    ctx.set_ref("//Scene")
+    ctx.item_click("Lesson")
+    ctx.item_click("//$FOCUSED/(none)")
+    ctx.yield_(3)
+    out["after_none"], out["scene_after_none"] = state.lesson, state.scene.name
 
 
 def scenario_hygiene(ctx, state, out: dict) -> None:

@@ -213,6 +213,7 @@ class Viewer:
         # the caption and fps readout first: nothing the gizmo does to the draw list's clip
         # rect can hide them
         presenter.draw_viewport_extras(state, origin, size, self.recorder.redrawn, band)
+        presenter.draw_lesson_buttons(state, origin, size, band)
         if not state.compare:
             gizmos.draw(state, origin, size)
         self.recorder.viewport_shown = True

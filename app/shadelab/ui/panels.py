@@ -7,6 +7,7 @@ Panels only read and write :class:`shadelab.ui.state.AppState`; GL work is asked
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 from imgui_bundle import imgui, implot
@@ -121,6 +122,22 @@ def save_here(state: AppState) -> None:
         dialogs.ask(state, "save")
 
 
+def draw_lesson_row(state: AppState) -> None:
+    """Pick a shipped lesson (its Prev / Next buttons sit under the viewport's caption;
+    PageUp / PageDown do the same); (none) ends it and keeps the scene."""
+    from shadelab.ui import lesson
+
+    run = state.lesson
+    current = "" if run is None else Path(run.lesson.path).stem
+    if imgui.begin_combo("Lesson", current or "(none)"):
+        if imgui.selectable("(none)", run is None)[0]:
+            state.lesson = None                    # the scene stays as it is
+        for name in lesson.list_lessons():
+            if imgui.selectable(name, name == current)[0]:
+                state.request_open(str(lesson.lessons_dir() / f"{name}.toml"))
+        imgui.end_combo()
+
+
 def draw_file_panel(state: AppState) -> bool:
     """Open a preset from the list or a file; save; undo/redo."""
     if state.error:
@@ -136,6 +153,7 @@ def draw_file_panel(state: AppState) -> bool:
             if imgui.selectable(name, name == current)[0]:
                 state.request_open(name)  # asks first when there are unsaved edits
         imgui.end_combo()
+    draw_lesson_row(state)
     # Native dialogs first (what a user reaches for), then a typed path for scripts and tests.
     for label, purpose in (("Open...", "open"), ("Save", "save-here"), ("Save as...", "save"),
                            ("Add mesh...", "mesh")):

@@ -251,9 +251,40 @@ def caption_scale(state: AppState) -> float:
     return 1.4 if state.lesson is not None else 1.0
 
 
+def lesson_running(state: AppState) -> bool:
+    return state.lesson is not None and state.lesson.step is not None
+
+
 def caption_band(state: AppState, width: float) -> float:
-    """Height of the caption band the viewport keeps under its image (0: no caption)."""
-    return caption_height(caption_text(state), width, caption_scale(state))
+    """Height of the caption band the viewport keeps under its image (0: no caption); in a
+    lesson it holds a row for the Prev / Next buttons too."""
+    height = caption_height(caption_text(state), width, caption_scale(state))
+    if height and lesson_running(state):
+        height += imgui.get_frame_height_with_spacing()
+    return height
+
+
+LESSON_BUTTONS = ("< Prev (PgUp)", "Next > (PgDn)")
+
+
+def draw_lesson_buttons(state: AppState, origin, size, band: float) -> None:
+    """Prev / Next at the bottom right of the caption band: in the viewport, so they stay in
+    reach whichever panel a step brings forward (PageUp / PageDown do the same)."""
+    if band <= 0 or not lesson_running(state):
+        return
+    from shadelab.ui import lesson
+
+    style = imgui.get_style()
+    widths = [imgui.calc_text_size(label).x + 2 * style.frame_padding.x
+              for label in LESSON_BUTTONS]
+    x = origin.x + size[0] - sum(widths) - style.item_spacing.x - 8
+    y = origin.y + size[1] + band + 4 - imgui.get_frame_height() - 4
+    imgui.set_cursor_screen_pos(imgui.ImVec2(x, y))
+    if imgui.button(LESSON_BUTTONS[0]):
+        lesson.previous_step(state)
+    imgui.same_line()
+    if imgui.button(LESSON_BUTTONS[1]):
+        lesson.next_step(state)
 
 
 def draw_viewport_extras(state: AppState, origin, size, redrawn: bool,
