@@ -103,6 +103,12 @@ def test_a_lesson_is_picked_and_stepped_from_the_scene_panel(bigdisplay, tmp_pat
     assert r["after_none"] is None and r["scene_after_none"] == "sphere-shading"
 
 
+def test_the_cameras_framing_is_edited_live_from_the_display_section(bigdisplay, tmp_path):
+    r = _run("camera_framing", bigdisplay, tmp_path)
+    assert r["fov_y"] == pytest.approx(60.0) and r["fit_aspect"] == pytest.approx(1.5)
+    assert r["title"].endswith("*")            # scene fields: the unsaved marker shows
+
+
 def test_preset_load_undo_and_overlays_cleared(bigdisplay, tmp_path):
     r = _run("hygiene", bigdisplay, tmp_path)
     assert r["loaded"] == "cornell" and r["undone"] == "lecture" and r["redone"] == "cornell"
@@ -148,6 +154,9 @@ def _check_layout(ctx, state, out: dict) -> None:
         ctx.yield_()
     ctx.yield_(2)
     out["display"] = [int(imgui.get_io().display_size.x), int(imgui.get_io().display_size.y)]
+    ctx.window_focus("//Scene")
+    ctx.item_open("//Scene/Display and presenter")   # its rows are checked too
+    ctx.yield_(2)
     clipped, checked = [], {}
     for label in DOCK_WINDOWS:
         ctx.window_focus(f"//{label}")
@@ -329,6 +338,18 @@ def scenario_lesson_panel(ctx, state, out: dict) -> None:
     ctx.item_click("//$FOCUSED/(none)")
     ctx.yield_(3)
     out["after_none"], out["scene_after_none"] = state.lesson, state.scene.name
+
+
+def scenario_camera_framing(ctx, state, out: dict) -> None:
+    ctx.yield_(3)
+    ctx.window_focus("//Scene")
+    ctx.set_ref("//Scene")
+    ctx.item_open("Display and presenter")
+    ctx.item_input_value("field of view", 60.0)
+    ctx.item_input_value("fit aspect", 1.5)
+    ctx.yield_(3)
+    cam = state.scene.camera
+    out["fov_y"], out["fit_aspect"], out["title"] = cam.fov_y, cam.fit_aspect, state.title()
 
 
 def scenario_hygiene(ctx, state, out: dict) -> None:

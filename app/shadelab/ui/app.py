@@ -490,7 +490,7 @@ def _scene_panel(state: AppState) -> bool:
     _, state.render_scale = panels._slider("render scale", state.render_scale, 0.25, 1.0)
     _, state.interactive_scale = panels._slider("while dragging", state.interactive_scale,
                                                 0.25, 1.0)
-    presenter.draw_display_panel(state)
+    edited |= presenter.draw_display_panel(state)
     return edited
 
 

@@ -314,7 +314,9 @@ def draw_viewport_extras(state: AppState, origin, size, redrawn: bool,
 
 
 def draw_display_panel(state: AppState) -> bool:
-    """Display options (not part of the scene): tone map, clipping, AA, lines, fps."""
+    """Display options (tone map, clipping, AA, lines, fps; not part of the scene) and the
+    camera's framing (field of view, fit aspect: scene fields, so it returns whether they
+    were edited)."""
     if not imgui.collapsing_header("Display and presenter"):
         return False
     imgui.text("Tone map")
@@ -326,12 +328,20 @@ def draw_display_panel(state: AppState) -> bool:
     _, state.show_clipping = imgui.checkbox("Show clipped pixels (stripes)", state.show_clipping)
     draw_antialias_choice(state)
     _, state.show_fps = imgui.checkbox("fps readout", state.show_fps)
-    _, state.line_width = imgui.slider_float("line width (0: auto)", state.line_width, 0.0, 8.0,
-                                             "%.1f px")
+    _, state.line_width = imgui.slider_float("line width", state.line_width, 0.0, 8.0,
+                                             "%.1f px" if state.line_width > 0 else "auto")
+    imgui.set_item_tooltip("0: by the presenter scale (>= 3 px in presenter mode)")
     _, state.show_gizmos = imgui.checkbox("Light gizmos", state.show_gizmos)
     _, state.hide_panels = imgui.checkbox("Viewport only (Tab)", state.hide_panels)
     _, state.fullscreen = imgui.checkbox("Fullscreen (F11)", state.fullscreen)
-    return False
+    # the camera's framing (scene fields): fov_y, and the narrowest aspect kept side to side
+    from shadelab.ui.render_panel import float_slider
+
+    cam = state.scene.camera
+    edited = float_slider("field of view", cam, "fov_y", 10.0, 120.0, fmt="%.1f deg")
+    edited |= float_slider("fit aspect", cam, "fit_aspect", 0.0, 3.0,
+                           fmt="%.2f")
+    return edited
 
 
 def antialias_choices(limit: int) -> list[tuple[str, int, int]]:
