@@ -85,7 +85,9 @@ def _save(state: AppState) -> None:
 
 
 K = imgui.Key
-CTRL = imgui.Key.mod_ctrl
+# Chords are plain ints: OR-ing two imgui.Key members (an IntFlag) raises AttributeError in
+# Python < 3.11.4's enum (Debian 12's python3 is 3.11.2).
+CTRL = int(imgui.Key.mod_ctrl)
 # (key chord, shown as, what it does, action) — the help overlay lists this table.
 SHORTCUTS = (
     (K._1, "1", "flat shading", _set("shading", "flat")),
@@ -105,9 +107,9 @@ SHORTCUTS = (
     (K.f11, "F11", "fullscreen", presenter.toggle_fullscreen),
     (K.page_down, "PgDn", "next lesson step", lesson.next_step),
     (K.page_up, "PgUp", "previous lesson step", lesson.previous_step),
-    (CTRL | K.z, "Ctrl+Z", "undo", AppState.undo),
-    (CTRL | K.y, "Ctrl+Y", "redo", AppState.redo),
-    (CTRL | K.s, "Ctrl+S", "save the preset", _save),
+    (CTRL | int(K.z), "Ctrl+Z", "undo", AppState.undo),
+    (CTRL | int(K.y), "Ctrl+Y", "redo", AppState.redo),
+    (CTRL | int(K.s), "Ctrl+S", "save the preset", _save),
 )
 MOUSE_HELP = (("left drag", "orbit"), ("right / middle drag", "pan"), ("wheel", "zoom"),
               ("left click", "probe the pixel"))
