@@ -371,7 +371,7 @@ OUT_DIR = "."
 def imgui_key(name: str):
     from imgui_bundle import imgui
 
-    return getattr(imgui.Key, name)
+    return int(getattr(imgui.Key, name))  # a plain int: chords OR on every Python 3.11
 
 
 def imgui_vec(x: float, y: float):

@@ -324,7 +324,7 @@ OUT_DIR = "."
 def _key(name: str):
     from imgui_bundle import imgui
 
-    return getattr(imgui.Key, name)
+    return int(getattr(imgui.Key, name))  # a plain int: chords OR on every Python 3.11
 
 
 def _main(name: str, out_dir: str) -> int:

@@ -361,13 +361,13 @@ def scenario_hygiene(ctx, state, out: dict) -> None:
     state.request_open("cornell")  # no edits: opens at once
     ctx.yield_(3)
     out["loaded"] = state.scene.name
-    ctx.key_press(imgui.Key.mod_ctrl | imgui.Key.z)
+    ctx.key_press(int(imgui.Key.mod_ctrl) | int(imgui.Key.z))
     ctx.yield_(3)
     out["undone"], out["title_after_undo"] = state.scene.name, state.title()
-    ctx.key_press(imgui.Key.mod_ctrl | imgui.Key.y)
+    ctx.key_press(int(imgui.Key.mod_ctrl) | int(imgui.Key.y))
     ctx.yield_(3)
     out["redone"] = state.scene.name
-    ctx.key_press(imgui.Key.mod_ctrl | imgui.Key.z)
+    ctx.key_press(int(imgui.Key.mod_ctrl) | int(imgui.Key.z))
     ctx.yield_(3)
     # unsaved edits: opening asks; Cancel keeps the scene and the edits
     state.scene.materials["plastic"].kd = 0.123
@@ -402,7 +402,7 @@ def scenario_hygiene(ctx, state, out: dict) -> None:
     state.mark_edited()
     ctx.yield_(3)
     out["overlays_after_edit"] = [state.radiosity_soup is not None, state.ray_tree is not None]
-    ctx.key_press(imgui.Key.mod_ctrl | imgui.Key.z)
+    ctx.key_press(int(imgui.Key.mod_ctrl) | int(imgui.Key.z))
     ctx.yield_(3)
     out["camera_undo"] = moved_eye != eye and tuple(state.scene.camera.eye) == moved_eye
 

@@ -136,7 +136,7 @@ def scenario_translate(ctx, state, out: dict) -> None:
     after = _mask_stats(_viewport_image(ctx, state, "after"))
     out["translate"] = list(state.scene.objects[0].translate)
     out["undo_steps"] = state.history.index - steps_before
-    ctx.key_press(imgui.Key.mod_ctrl | imgui.Key.z)
+    ctx.key_press(int(imgui.Key.mod_ctrl) | int(imgui.Key.z))
     ctx.yield_(6)
     out["undone_translate"] = list(state.scene.objects[0].translate)
     undone = _mask_stats(_viewport_image(ctx, state, "undone"))

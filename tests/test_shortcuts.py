@@ -29,3 +29,17 @@ def test_modifier_chords_are_plain_ints_with_ctrl_and_the_key():
         key = getattr(imgui.Key, shown[-1].lower())
         assert chord == ctrl | int(key), shown
         assert chord & ~ctrl == int(key), shown
+
+
+def test_no_enum_arithmetic_on_imgui_keys_in_the_package_or_its_tests():
+    """``Key.a | Key.b`` is the crash; every chord ORs ints (``int(Key.a) | int(Key.b)``)."""
+    import re
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    pattern = re.compile(r"\bKey\.\w+\s*\||\|\s*(?:imgui\.)?Key\.\w+|\bK\.\w+\s*\||\|\s*K\.\w+")
+    offenders = [f"{path.relative_to(root)}:{n}"
+                 for path in [*(root / "app").rglob("*.py"), *(root / "tests").rglob("*.py")]
+                 for n, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1)
+                 if pattern.search(line) and path.name != "test_shortcuts.py"]
+    assert not offenders
