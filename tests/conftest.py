@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import sys
 import tempfile
 from pathlib import Path
 
@@ -21,6 +22,9 @@ settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 os.environ["SHADELAB_CACHE_DIR"] = tempfile.mkdtemp(prefix="shadelab-test-cache-")
 
 ROOT = Path(__file__).resolve().parent.parent
+# Tests live in one folder per layer (tests/scene, tests/raster, ...); their shared helpers
+# (golden.py, gui_harness.py) stay here, importable from every folder.
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 GOLDEN_DIR = Path(__file__).resolve().parent / "golden"
 OUTPUT_DIR = Path(__file__).resolve().parent / "_output"
 

@@ -71,7 +71,7 @@ def run_scenario_main(scenarios: dict, name: str, out_dir: str, preset: str = "c
     return 0
 
 
-GL_MODULES = ("moderngl", "OpenGL", "glfw", "shadelab.gl", "shadelab.render",
+GL_MODULES = ("moderngl", "OpenGL", "glfw", "shadelab.gl", "shadelab.raster",
               "shadelab.ui.viewport", "shadelab.ui.gpu_side")
 
 

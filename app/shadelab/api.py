@@ -275,7 +275,7 @@ def render(scene: Scene | str, size: Any = None, shading: str | None = None,
     exposure = scene.render.exposure
     info: dict[str, Any] = {"pipeline": pipeline, "size": wh}
     if pipeline in ("raster", "painter"):
-        from shadelab.render.offscreen import render_image
+        from shadelab.raster.offscreen import render_image
 
         if pipeline == "painter" and scene.render.visibility != "painter":
             scene = copy.deepcopy(scene)
@@ -321,7 +321,7 @@ def render(scene: Scene | str, size: Any = None, shading: str | None = None,
     last = run_to_end(iter_radiosity(scene, None, patches, form_factors, solver),
                       desc="radiosity", show=progress)
     solution = last.stats["solution"]
-    from shadelab.render.radiosity_image import render_solution
+    from shadelab.raster.radiosity_image import render_solution
 
     stats = {k: v for k, v in solution.stats.items() if k != "history"}
     info.update(stats)

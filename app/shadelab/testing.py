@@ -269,7 +269,7 @@ def render_with_shaders(scene: Any, includes: dict[str, str | Path], size: Any =
     from shadelab.api import Image, _scene, _size
     from shadelab.gl.context import headless_context
     from shadelab.gl.target import RenderTarget
-    from shadelab.render.renderer import Renderer
+    from shadelab.raster.renderer import Renderer
 
     scene = _scene(scene)
     wh = _size(size, "raster")

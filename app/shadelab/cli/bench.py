@@ -14,11 +14,11 @@ import platform
 import sys
 
 SECTIONS = (
-    ("raster", "shadelab.render.bench"),
-    ("shadows", "shadelab.render.bench_shadows"),
-    ("viewer", "shadelab.ui.bench"),
-    ("raytrace", "shadelab.raytrace.bench"),
-    ("radiosity", "shadelab.radiosity.bench"),
+    ("raster", "shadelab.bench.raster"),
+    ("shadows", "shadelab.bench.shadows"),
+    ("viewer", "shadelab.bench.viewer"),
+    ("raytrace", "shadelab.bench.raytrace"),
+    ("radiosity", "shadelab.bench.radiosity"),
 )
 
 

@@ -44,7 +44,7 @@ def run_radiosity(args: argparse.Namespace) -> int:
 
         check_budget(args.error)
     check_outputs(args)
-    from shadelab.render.radiosity import iter_radiosity, precheck  # with the GPU hemicube
+    from shadelab.raster.radiosity import iter_radiosity, precheck  # with the GPU hemicube
 
     if getattr(args, "error", None) is not None:
         from shadelab.studies.radiosity_study import auto_radiosity
@@ -63,7 +63,7 @@ def run_radiosity(args: argparse.Namespace) -> int:
                          adaptive=not args.uniform)
     last = run_to_end(job, desc="radiosity")
     solution = last.stats["solution"]
-    from shadelab.render.radiosity_image import render_solution  # GL only once solved
+    from shadelab.raster.radiosity_image import render_solution  # GL only once solved
 
     image = render_solution(solution, size)
     save_outputs(args, image, scene.render.exposure)

@@ -65,7 +65,7 @@ def run_render(args: argparse.Namespace) -> int:
 
         check_budget(args.error)
     check_outputs(args)
-    from shadelab.render.offscreen import render_image  # GL only once the input is known good
+    from shadelab.raster.offscreen import render_image  # GL only once the input is known good
 
     if getattr(args, "error", None) is not None:
         from shadelab.studies.autoquality import auto_tessellate
@@ -98,7 +98,7 @@ def run_validate(args: argparse.Namespace) -> int:
         from shadelab.geometry.mesh import scene_meshes
 
         meshes = scene_meshes(scene)  # mesh files must load too
-        from shadelab.render.textures import BUMP_MODES, TEXTURE_MODES, check_image_file
+        from shadelab.raster.textures import BUMP_MODES, TEXTURE_MODES, check_image_file
 
         for mname, m in scene.materials.items():  # and images be images within the limit
             if m.texture not in TEXTURE_MODES:

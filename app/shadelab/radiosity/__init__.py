@@ -1,8 +1,8 @@
 """Radiosity: patches, form factors (hemicube, ray-cast, analytic), solvers, Gouraud display.
 
-Pure layer: no GL anywhere. The GPU hemicube (:mod:`shadelab.render.hemicube`) is passed in as
-a backend (``hemicube=Hemicube``); the GL image is :mod:`shadelab.render.radiosity_image`, and
-:mod:`shadelab.render.radiosity` binds the two to the solver. The main entry
+Pure layer: no GL anywhere. The GPU hemicube (:mod:`shadelab.raster.hemicube`) is passed in as
+a backend (``hemicube=Hemicube``); the GL image is :mod:`shadelab.raster.radiosity_image`, and
+:mod:`shadelab.raster.radiosity` binds the two to the solver. The main entry
 points are re-exported lazily (numba and embreex load on first use):
 ``iter_radiosity``, ``solve_scene``, ``RadiositySolution`` (``shadelab.radiosity.solution``).
 """

@@ -2,7 +2,7 @@
 
 Three ways, as in the lecture and the literature:
 
-* ``analytic`` -- unoccluded. The exact point-to-polygon form factor (Lambert / DESIGN.md §5)
+* ``analytic`` -- unoccluded. The exact point-to-polygon form factor (Lambert / ARCHITECTURE.md §5)
 
       F(dA_x -> A_j) = (1 / 2 pi) |sum_k gamma_k n_x . (R_k x R_k+1) / |R_k x R_k+1||
 
@@ -13,7 +13,7 @@ Three ways, as in the lecture and the literature:
   ``cos_i cos_j dA / (pi r^2 + dA)``. The visible share multiplies the exact unoccluded
   kernel at that point, so an unoccluded pair is exact and an occluded one is sampled.
 * ``hemicube`` -- Cohen & Greenberg 1985 on the GPU. This module stays GL-free: the caller
-  passes the backend, ``FormFactors(..., hemicube=shadelab.render.hemicube.Hemicube)``.
+  passes the backend, ``FormFactors(..., hemicube=shadelab.raster.hemicube.Hemicube)``.
 
 Rows are computed on demand (:class:`FormFactors`), so progressive refinement can start
 shooting before the whole matrix exists, as it did in Cohen et al. 1988.
@@ -240,7 +240,7 @@ class FormFactors:
     order : receiver quadrature, order x order Gauss-Legendre points (raycast, analytic)
     hemicube : the GPU backend for ``method="hemicube"``: a factory
         ``hemicube(patches, resolution, samples)`` of an object with ``rows(indices)`` and
-        ``release()``, e.g. :class:`shadelab.render.hemicube.Hemicube` (required for hemicube)
+        ``release()``, e.g. :class:`shadelab.raster.hemicube.Hemicube` (required for hemicube)
     """
 
     def __init__(self, patches: PatchSet, method: str = "raycast", resolution: int = 128,
@@ -396,7 +396,7 @@ def check_backend(method: str, hemicube) -> None:
     """Refuse ``method="hemicube"`` without a GPU backend (this layer imports no GL)."""
     if method == "hemicube" and hemicube is None:
         raise ShadeLabError("hemicube form factors need a GPU backend: pass "
-                            "hemicube=shadelab.render.hemicube.Hemicube (or use "
+                            "hemicube=shadelab.raster.hemicube.Hemicube (or use "
                             "form_factors='raycast')")
 
 

@@ -8,7 +8,7 @@
 * T-vertex cracks: adaptive subdivision puts fine corners in the middle of coarse edges;
   drawn naively the two sides interpolate different values along that edge.
 
-The pictures (GL) are written by ``python -m shadelab.render.radiosity OUTDIR``; this module
+The pictures (GL) are written by ``python -m shadelab.raster.radiosity OUTDIR``; this module
 stays GL-free, so the hemicube backend is passed in (``hemicube_aliasing(hemicube=...)``).
 """
 
@@ -43,7 +43,7 @@ def hemicube_aliasing(resolutions=(8, 256), side: float = 0.2, shifts=None,
     """F from the receiver's centre to a small square, by hemicube at each resolution, for
     several sub-pixel shifts, against the exact point-to-polygon value.
 
-    ``hemicube``: the GPU backend (:class:`shadelab.render.hemicube.Hemicube`), required.
+    ``hemicube``: the GPU backend (:class:`shadelab.raster.hemicube.Hemicube`), required.
     """
     check_backend("hemicube", hemicube)
     shifts = np.linspace(0.0, 1.0, 9) if shifts is None else np.asarray(shifts)

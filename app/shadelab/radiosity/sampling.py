@@ -1,6 +1,6 @@
 """Quadrature points on patches and the hemicube's delta form factors: the pure numpy pieces
 that the form-factor engine (:mod:`shadelab.radiosity.formfactors`) and the GPU hemicube
-(:mod:`shadelab.render.hemicube`) share.
+(:mod:`shadelab.raster.hemicube`) share.
 """
 
 from __future__ import annotations

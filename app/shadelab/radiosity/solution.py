@@ -2,11 +2,11 @@
 
 ``solve_scene`` runs it all and returns a :class:`RadiositySolution`; ``iter_radiosity`` is the
 same job as a progressive generator of :class:`shadelab.progress.Progress` for the viewer's side
-panel and the CLI's progress bar. Units (DESIGN.md §2): rho = kd * Od, E = pi * Le,
+panel and the CLI's progress bar. Units (ARCHITECTURE.md §2): rho = kd * Od, E = pi * Le,
 B = pi * L; images and ``display_meshes`` hold radiance L = B / pi.
 
 This layer imports no GL: hemicube form factors need the GPU backend passed in, as
-``hemicube=shadelab.render.hemicube.Hemicube`` (:mod:`shadelab.render.radiosity` binds it).
+``hemicube=shadelab.raster.hemicube.Hemicube`` (:mod:`shadelab.raster.radiosity` binds it).
 """
 
 from __future__ import annotations
@@ -234,7 +234,7 @@ def iter_radiosity(scene: Scene, size: tuple[int, int] | None = None, patches: i
     (iteration, residual, unshot, time_s of the current stage's solver), and, at the end,
     ``solution`` (a :class:`RadiositySolution`). Close the generator to cancel.
     ``hemicube``: the GPU backend, required when the method is "hemicube"
-    (``shadelab.render.hemicube.Hemicube``; see :class:`FormFactors`).
+    (``shadelab.raster.hemicube.Hemicube``; see :class:`FormFactors`).
     ``meshing``: the first mesh, "uniform" (a regular grid) or "discontinuity" (refined along
     contact lines and shadow boundaries, hidden cells dropped: :mod:`.meshing`).
     """

@@ -4,7 +4,7 @@ vertex (emission with MIS, next-event set-up, lobe choice, Russian roulette).
 
 :func:`local_shade` mirrors :func:`shadelab.shading.reference.shade` term by term (same guards:
 EPS = 1e-12, pow only where the cosine is positive, f_att = 1 at infinite distance);
-``tests/test_raytrace_kernels.py`` holds the two together on random inputs. The tracers use
+``tests/raytrace/test_raytrace_kernels.py`` holds the two together on random inputs. The tracers use
 these kernels by default and the numpy reference with ``TraceContext(local="numpy")``.
 """
 

@@ -2,7 +2,7 @@
 
     L(x, w) = Le(x) + integral over the hemisphere of f(x) L(x', -w') cos(theta') dw'
 
-Units follow DESIGN.md section 2: radiance throughout, a diffuse BRDF f = rho / pi with
+Units follow ARCHITECTURE.md section 2: radiance throughout, a diffuse BRDF f = rho / pi with
 rho = kd * Od, and a material's ``emission`` is its radiance Le (two-sided, as the raster
 shows it). The lecture's point, spot and directional lights light the scene too, as delta
 lights sampled at every path vertex: their direct term is exactly the lecture's

@@ -1,5 +1,5 @@
 """Lights packed into arrays, once, in numpy: what both the GL uniform writer
-(:func:`shadelab.render.renderer.write_light_uniforms`) and the numba kernels' light table
+(:func:`shadelab.raster.renderer.write_light_uniforms`) and the numba kernels' light table
 (:func:`shadelab.raytrace.kernels.light_table`) are filled from.
 """
 

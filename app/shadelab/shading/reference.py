@@ -5,7 +5,7 @@ the surface; normals are unit; colors are linear RGB; arrays broadcast over lead
 (``(..., 3)`` vectors, ``(...)`` scalars).
 
 ``shaders/include/lighting.glsl`` mirrors every function here with the same name and
-argument order; ``tests/test_glsl_parity.py`` holds the two together.
+argument order; ``tests/shading/test_glsl_parity.py`` holds the two together.
 """
 
 from __future__ import annotations

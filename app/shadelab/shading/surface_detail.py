@@ -9,7 +9,7 @@ programs), so the ray tracers shade textured materials as the raster does:
   sin(2 pi y) for ``"bumps"`` or a height image (central differences one texel apart), over
   pattern coordinates x = s u, y = s v; k = ``bump_scale``; T, B the unit directions of
   increasing u and v, orthogonalized against N;
-- image lookups as the GL sampler of :mod:`shadelab.render.textures`: GL_REPEAT wrap,
+- image lookups as the GL sampler of :mod:`shadelab.raster.textures`: GL_REPEAT wrap,
   bilinear (GL_LINEAR, level 0), texel centres at (i + 0.5) / W, row 0 at v = 0.
 
 Also the image loading (sRGB decoded to linear; height maps as stored), which the GL side

@@ -26,7 +26,7 @@ class GalleryCase:
     test_name: str               # tests/<file>::<test> that asserts the failure
 
 
-T = "tests/test_gallery.py::"
+T = "tests/studies/test_gallery.py::"
 
 GALLERY: list[GalleryCase] = [
     GalleryCase(
@@ -152,7 +152,7 @@ def render_case(case: GalleryCase, size: tuple[int, int]) -> tuple[np.ndarray, f
     scene = load_case(case)
     kind, _, variant = case.method.partition(":")
     if kind == "raster":
-        from shadelab.render.offscreen import render_image
+        from shadelab.raster.offscreen import render_image
 
         image = render_image(scene, size, variant or None)
     elif kind == "raytrace":
@@ -173,6 +173,6 @@ def render_case(case: GalleryCase, size: tuple[int, int]) -> tuple[np.ndarray, f
 
 def _render_radiosity(scene, size: tuple[int, int], adaptive: bool = True) -> np.ndarray:
     from shadelab.radiosity.solution import solve_scene
-    from shadelab.render.hemicube import Hemicube  # the GPU backend of hemicube form factors
+    from shadelab.raster.hemicube import Hemicube  # the GPU backend of hemicube form factors
 
     return solve_scene(scene, adaptive=adaptive, hemicube=Hemicube).image(size)

@@ -28,7 +28,7 @@ def solve_timed(scene: Scene, patches: int, method: str, resolution: int, solver
                 repeats: int = 1):
     """(solution, milliseconds: best of ``repeats``) for a uniform-patch solve."""
     from shadelab.radiosity.solution import solve_scene
-    from shadelab.render.hemicube import Hemicube  # the GPU backend of hemicube form factors
+    from shadelab.raster.hemicube import Hemicube  # the GPU backend of hemicube form factors
 
     best = float("inf")
     for _ in range(repeats):
@@ -61,9 +61,9 @@ def convergence(solution, solver: str) -> list[list]:
 def meshing_table(scene: Scene, quick: bool = False) -> StudyResult:
     """Error against wall time, uniform against discontinuity meshing, both against a
     converged path-traced reference (relative L1 away from the light, the bench's metric:
-    :func:`shadelab.radiosity.bench.error_in_budget` gives the same series at 32 x 32 and
+    :func:`shadelab.bench.radiosity.error_in_budget` gives the same series at 32 x 32 and
     16k spp; the quick table uses 16 x 16 and 2 x 512 spp, cached on disk)."""
-    from shadelab.radiosity import bench
+    from shadelab.bench import radiosity as bench
     from shadelab.radiosity.solution import solve_scene
 
     size, spp, counts = ((16, 16), 512, (100, 300)) if quick else \

@@ -95,7 +95,7 @@ def isolated(scene: Scene, index: int, level: int | None = None) -> Scene:
 
 def coverage(scene: Scene, size: tuple[int, int]) -> np.ndarray:
     """(H, W) bool: the pixels the raster renderer covers (an emission-only render)."""
-    from shadelab.render.offscreen import render_image
+    from shadelab.raster.offscreen import render_image
 
     masked = copy.deepcopy(scene)
     masked.materials = {"mask": Material(ka=0.0, kd=0.0, ks=0.0, emission=(1.0, 1.0, 1.0))}
@@ -126,7 +126,7 @@ def interior(mask: np.ndarray) -> np.ndarray:
 def timed_render(scene: Scene, size: tuple[int, int], shading: str, specular: str | None,
                  repeats: int) -> tuple[np.ndarray, float]:
     """The raster image and the best frame time of ``repeats`` (render + readback), ms."""
-    from shadelab.render.offscreen import render_image
+    from shadelab.raster.offscreen import render_image
 
     image = render_image(scene, size, shading, specular)  # warm-up: upload, compile
     samples = []

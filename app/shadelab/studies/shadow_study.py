@@ -59,8 +59,8 @@ def _subset(hits, idx):
 
 def stencil_masks(scene: Scene, size: tuple[int, int]) -> np.ndarray:
     """(L, H, W) True where the GL stencil count for light i is non-zero."""
-    from shadelab.render.offscreen import shared_renderer, shared_target
-    from shadelab.render.shadows import shadow_masks
+    from shadelab.raster.offscreen import shared_renderer, shared_target
+    from shadelab.raster.shadows import shadow_masks
 
     return shadow_masks(shared_renderer(), scene, shared_target(size))
 
@@ -74,7 +74,7 @@ def mismatch(stencil: np.ndarray, shadowed: np.ndarray, valid: np.ndarray) -> fl
 
 def frame_ms(scene: Scene, size: tuple[int, int], repeats: int) -> float:
     """Best frame time of ``repeats`` (render with shadow volumes + readback), milliseconds."""
-    from shadelab.render.offscreen import render_image
+    from shadelab.raster.offscreen import render_image
 
     render_image(scene, size)
     samples = []

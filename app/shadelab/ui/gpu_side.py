@@ -58,7 +58,7 @@ class GpuSide:
         return self.viewport.read_linear(pane)
 
     def _cube(self, args: dict):
-        from shadelab.render.hemicube import Hemicube
+        from shadelab.raster.hemicube import Hemicube
 
         key = args["key"]
         if self._hemicube is None or self._hemicube[0] != key:

@@ -8,7 +8,7 @@ the patch's row of F. Below, F as an ImPlot heat map (block means when N > ``HEA
 and its row sums (1 in a closed scene).
 
 The window asks the viewer's GL side for the work (``state.gpu`` requests, served by
-:mod:`shadelab.ui.gpu_side` with :class:`shadelab.render.hemicube.Hemicube` before the next
+:mod:`shadelab.ui.gpu_side` with :class:`shadelab.raster.hemicube.Hemicube` before the next
 frame's panels): a patch's item images, and F's rows ``Hemicube.batch`` per frame, so the UI
 never waits. Results are cached per geometry (the patches' key: a material or emission edit
 keeps it) and patch. This module holds no GL object and imports no GL module.
@@ -54,7 +54,7 @@ def unfold(top: np.ndarray, sides: list, fill=-2) -> np.ndarray:
     the picture is continuous across every seam. Outside the cross: ``fill``.
 
     Top face: columns run along -t, rows along -b (row 0 at +b); side faces look along
-    +t, +b, -t, -b (see :meth:`shadelab.render.hemicube.Hemicube._faces`)."""
+    +t, +b, -t, -b (see :meth:`shadelab.raster.hemicube.Hemicube._faces`)."""
     res = top.shape[0]
     h = res // 2
     out = np.full((2 * res, 2 * res) + top.shape[2:], fill, dtype=np.result_type(top, fill))

@@ -13,7 +13,7 @@ import numpy as np
 
 from shadelab.gl.programs import load_program, set_uniform
 from shadelab.gl.target import RenderTarget
-from shadelab.render.renderer import Renderer, View
+from shadelab.raster.renderer import Renderer, View
 from shadelab.scene.camera import gl_matrix
 from shadelab.scene.model import Scene
 
@@ -101,7 +101,7 @@ class Viewport:
     def draw_colored_triangles(self, pane: Pane, scene: Scene, soup: np.ndarray) -> None:
         """Per-vertex radiance triangles (a radiosity solution), Gouraud-interpolated."""
         from shadelab.geometry.mesh import scene_meshes
-        from shadelab.render.renderer import make_view
+        from shadelab.raster.renderer import make_view
 
         pane.view = make_view(scene, pane.size, scene_meshes(scene))
         pane.target.clear(scene.render.background)

@@ -1,0 +1,358 @@
+"""Stencil shadow volumes on moderngl (the GL side; geometry in shadelab/geometry/silhouette.py).
+
+Per light: clear the stencil, draw every caster's volume with color and depth writes off and
+two-sided stencil counting, then draw that light's contribution additively where the count is
+zero. z-fail (Carmack's reverse) counts volume faces *behind* the visible surface (back faces
++1, front faces -1) and is robust with the eye inside a volume, given far caps at infinity
+(w = 0, infinite far plane, depth clamp on). z-pass counts faces *in front* (front +1, back -1)
+and breaks when the eye sits inside a volume: it is here to show that failure.
+
+moderngl has no stencil API: stencil state goes through PyOpenGL (ARCHITECTURE.md section 4).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import moderngl
+import numpy as np
+
+from shadelab.geometry.mesh import scene_bounds
+from shadelab.geometry.silhouette import (
+    ShadowVolume,
+    closed_caster,
+    light_homogeneous,
+    open_caster_groups,
+    open_volume,
+    shadow_volume,
+    shadows_nothing,
+)
+from shadelab.gl.programs import load_program, set_uniform
+from shadelab.scene.camera import gl_matrix
+from shadelab.scene.model import Light, Scene
+
+OFFSET_FRACTION = 1e-3  # open casters' volumes start this share of the scene's diagonal away
+VOLUME_COLOR = (0.25, 0.45, 1.0, 0.18)  # translucent volumes (linear RGB, alpha)
+SILHOUETTE_COLOR = (1.0, 0.85, 0.1, 1.0)
+HEAT_LEVELS = 8  # stencil counts 1..8 get their own color; above 8 shows as 8
+# kt-filtered shadows: with transparent casters the stencil splits into a 4-bit volume counter
+# (mod 16) and one "inside caster j's volume" flag per transparent caster (bits 4..7)
+COUNTER_MASK = 0x0F
+FILTER_SLOTS = 4  # transparent casters filtered per light; further ones cast no shadow
+
+
+def filter_bit(slot: int) -> int:
+    """The stencil flag of the transparent caster in ``slot`` (0 .. FILTER_SLOTS - 1)."""
+    return 1 << (4 + slot)
+
+
+def _gl():
+    from OpenGL import GL
+
+    return GL
+
+
+def heat_color(count: int) -> tuple[float, float, float, float]:
+    """Heat-map color of a stencil count (1 = blue ... 8 = red), half transparent."""
+    t = (min(count, HEAT_LEVELS) - 1) / (HEAT_LEVELS - 1)
+    return (t, 1.0 - abs(2.0 * t - 1.0), 1.0 - t, 0.6)
+
+
+def light_key(light: Light) -> tuple:
+    return (light.kind, tuple(light.position), tuple(light.direction))
+
+
+@dataclass
+class CasterVolume:
+    """One caster's volume for one light, on the GPU."""
+
+    key: tuple
+    volume: ShadowVolume
+    object_index: int
+    vbo: moderngl.Buffer
+    vao: moderngl.VertexArray
+    line_vbo: moderngl.Buffer
+    line_vao: moderngl.VertexArray
+
+    def release(self) -> None:
+        for item in (self.vao, self.vbo, self.line_vao, self.line_vbo):
+            item.release()
+
+
+class ShadowVolumes:
+    """Builds (and caches) shadow-volume geometry and runs the stencil passes."""
+
+    def __init__(self, ctx: moderngl.Context):
+        self.ctx = ctx
+        self.program = load_program(ctx, "shadow_volume")
+        self._cache: dict[tuple, CasterVolume] = {}
+        self._closed: dict[tuple, bool] = {}  # geometry key -> closed caster?
+        self._grouping: dict[tuple, list[list[int]]] = {}  # recent groupings of open casters
+        self._skips: dict[tuple, list[bool]] = {}  # recent shadows_nothing answers
+        quad = np.array([[-1, -1, 1, 1], [1, -1, 1, 1], [1, 1, 1, 1],
+                         [-1, -1, 1, 1], [1, 1, 1, 1], [-1, 1, 1, 1]], dtype=np.float32)
+        self._quad_vbo = ctx.buffer(quad.tobytes())
+        self._quad_vao = ctx.vertex_array(self.program, [(self._quad_vbo, "4f", "in_position")])
+
+    # ------------------------------------------------------------ geometry
+    def volumes(self, scene: Scene, gpu_meshes, light_index: int,
+                light: Light) -> list[CasterVolume]:
+        """The volumes of every shadow-casting object for one light (cached). A flat caster
+        with every other object on the light's side (a floor, a room's walls) is skipped: its
+        volume holds no receiver (:func:`shadows_nothing`), the stencil is the same.
+
+        Closed casters get their silhouette volume, transparent ones their own volume (each
+        is counted alone for its filter flag); the other open casters are grouped by shared
+        corners and each group gets one :func:`open_volume` (the union of their per-triangle
+        volumes without the sides that cancel: the same count, far less fill)."""
+        offset = OFFSET_FRACTION * float(np.linalg.norm(np.ptp(
+            scene_bounds([g.mesh for g in gpu_meshes]), axis=0)))
+        homogeneous = light_homogeneous(light.kind, light.position, light.direction)
+        out = []
+        live = set()
+        grouped = []
+        skipped = self._skipped(gpu_meshes, light, homogeneous, offset)
+        for position, gpu in enumerate(gpu_meshes):
+            obj = scene.objects[gpu.mesh.index] if gpu.mesh.index < len(scene.objects) else None
+            if obj is None or not obj.cast_shadows or skipped[position]:
+                continue
+            # kt > 0: renderer.is_transparent (filtered, so counted alone)
+            if scene.materials[obj.material].kt <= 0.0 and not self._is_closed(gpu):
+                grouped.append(gpu)
+                continue
+            slot = (gpu.mesh.index, light_index)
+            key = (gpu.key, light_key(light), offset)
+            live.add(slot)
+            out.append(self._cached(slot, key, gpu.mesh.index, lambda g=gpu: shadow_volume(
+                g.mesh.vertices, g.mesh.faces, homogeneous, offset)))
+        for group in self._groups(grouped):
+            members = [grouped[i] for i in group]
+            slot = (("open",) + tuple(g.mesh.index for g in members), light_index)
+            key = (tuple(g.key for g in members), light_key(light), offset)
+            live.add(slot)
+            out.append(self._cached(slot, key, members[0].mesh.index, lambda m=members: (
+                open_volume([(g.mesh.vertices, g.mesh.faces) for g in m], homogeneous,
+                            offset))))
+        for slot in [s for s in self._cache if s[1] == light_index and s not in live]:
+            self._cache.pop(slot).release()
+        return out
+
+    def _skipped(self, gpu_meshes, light: Light, homogeneous: np.ndarray,
+                 offset: float) -> list[bool]:
+        """:func:`shadows_nothing` of each mesh for this light, memoized on the light and
+        every mesh's geometry (the receivers' boxes): it runs again only after an edit."""
+        key = (tuple(g.key for g in gpu_meshes), light_key(light), offset)
+        skipped = self._skips.get(key)
+        if skipped is None:
+            skipped = [shadows_nothing(gpu.mesh.vertices, gpu.mesh.face_normals, homogeneous,
+                                       [g.bounds for g in gpu_meshes if g is not gpu], offset)
+                       for gpu in gpu_meshes]
+            if len(self._skips) > 64:
+                self._skips.clear()
+            self._skips[key] = skipped
+        return skipped
+
+    def _cached(self, slot: tuple, key: tuple, object_index: int, build) -> CasterVolume:
+        """The volume in ``slot`` if it was built for ``key``, else ``build()`` uploaded."""
+        cached = self._cache.get(slot)
+        if cached is None or cached.key != key:
+            if cached is not None:
+                cached.release()
+            cached = self._upload(key, object_index, build())
+            self._cache[slot] = cached
+        return cached
+
+    def _groups(self, grouped: list) -> list[list[int]]:
+        """:func:`open_caster_groups` of these meshes, memoized on their geometry keys."""
+        keys = tuple(g.key for g in grouped)
+        groups = self._grouping.get(keys)
+        if groups is None:
+            groups = open_caster_groups([g.mesh.vertices for g in grouped])
+            if len(self._grouping) > 64:
+                self._grouping.clear()
+            self._grouping[keys] = groups
+        return groups
+
+    def _is_closed(self, gpu) -> bool:
+        """Does the object's mesh make a closed caster (a silhouette volume)? Memoized."""
+        closed = self._closed.get(gpu.key)
+        if closed is None:
+            closed = closed_caster(gpu.mesh.vertices, gpu.mesh.faces) is not None
+            if len(self._closed) > 256:   # geometry edited many times: start again
+                self._closed.clear()
+            self._closed[gpu.key] = closed
+        return closed
+
+    def _upload(self, key: tuple, object_index: int, volume: ShadowVolume) -> CasterVolume:
+        vbo = self.ctx.buffer(volume.triangles().tobytes())
+        vao = self.ctx.vertex_array(self.program, [(vbo, "4f", "in_position")])
+        lines = volume.vertices[volume.silhouette].astype(np.float32)
+        line_vbo = self.ctx.buffer(lines.tobytes() if len(lines) else bytes(32))
+        line_vao = self.ctx.vertex_array(self.program, [(line_vbo, "4f", "in_position")])
+        return CasterVolume(key, volume, object_index, vbo, vao, line_vbo, line_vao)
+
+    def release_volumes(self) -> None:
+        """Drop every cached volume and memoized answer (built again on the next frame)."""
+        for caster in self._cache.values():
+            caster.release()
+        self._cache.clear()
+        self._skips.clear()
+        self._grouping.clear()
+        self._closed.clear()
+
+    def drop_lights_from(self, count: int) -> None:
+        for slot in [s for s in self._cache if s[1] >= count]:
+            self._cache.pop(slot).release()
+
+    # ------------------------------------------------------------ passes
+    def count(self, target, view, volumes: list[CasterVolume], method: str,
+              field: int = 0xFF) -> None:
+        """Stencil pass: clear the stencil and count volume faces (z-fail or z-pass).
+
+        ``field`` limits the clear and the count to those stencil bits (COUNTER_MASK: mod 16,
+        leaving the transparent casters' flags alone)."""
+        GL = _gl()
+        ctx = self.ctx
+        _ = ctx.error
+        target.fbo.color_mask = (False, False, False, False)
+        target.fbo.depth_mask = False
+        target.fbo.use()  # applies the masks (moderngl sets them on use)
+        _ = ctx.error
+        GL.glStencilMask(field)
+        GL.glClearStencil(0)
+        GL.glClear(GL.GL_STENCIL_BUFFER_BIT)
+        ctx.enable_only(moderngl.DEPTH_TEST)
+        ctx.depth_func = "<"
+        GL.glEnable(GL.GL_STENCIL_TEST)
+        if method == "zfail":  # far caps at w = 0 may round past depth 1: clamp, never clip
+            GL.glEnable(GL.GL_DEPTH_CLAMP)
+        GL.glStencilFunc(GL.GL_ALWAYS, 0, 0xFF)
+        if method == "zpass":
+            GL.glStencilOpSeparate(GL.GL_FRONT, GL.GL_KEEP, GL.GL_KEEP, GL.GL_INCR_WRAP)
+            GL.glStencilOpSeparate(GL.GL_BACK, GL.GL_KEEP, GL.GL_KEEP, GL.GL_DECR_WRAP)
+        else:
+            GL.glStencilOpSeparate(GL.GL_BACK, GL.GL_KEEP, GL.GL_INCR_WRAP, GL.GL_KEEP)
+            GL.glStencilOpSeparate(GL.GL_FRONT, GL.GL_KEEP, GL.GL_DECR_WRAP, GL.GL_KEEP)
+        set_uniform(self.program, "u_clip_from_world", gl_matrix(view.clip_from_world))
+        set_uniform(self.program, "u_color", (0.0, 0.0, 0.0, 0.0))
+        for caster in volumes:
+            caster.vao.render(moderngl.TRIANGLES)
+        GL.glDisable(GL.GL_DEPTH_CLAMP)
+        GL.glStencilOp(GL.GL_KEEP, GL.GL_KEEP, GL.GL_KEEP)
+        target.fbo.color_mask = (True, True, True, True)
+        target.fbo.use()  # color writes back on; depth writes stay off until the frame ends
+
+    def lit_where_zero(self, ref: int = 0) -> None:
+        """Stencil state for the additive lit pass: draw only where the stencil is ``ref``
+        (the volume count 0, and with transparent casters exactly their flags ``ref``)."""
+        GL = _gl()
+        _ = self.ctx.error
+        GL.glEnable(GL.GL_STENCIL_TEST)
+        GL.glStencilMask(0x00)
+        GL.glStencilFunc(GL.GL_EQUAL, ref, 0xFF)
+        GL.glStencilOp(GL.GL_KEEP, GL.GL_KEEP, GL.GL_KEEP)
+
+    def flag_inside(self, target, view, caster: CasterVolume, method: str, slot: int) -> None:
+        """Set ``filter_bit(slot)`` wherever the visible surface lies inside ``caster``'s
+        volume: count it alone in the counter bits, then turn a non-zero count into the flag
+        with a full-screen quad (color and depth untouched)."""
+        GL = _gl()
+        ctx = self.ctx
+        self.count(target, view, [caster], method, field=COUNTER_MASK)
+        target.fbo.color_mask = (False, False, False, False)
+        target.fbo.use()
+        ctx.enable_only(moderngl.NOTHING)
+        _ = ctx.error
+        GL.glEnable(GL.GL_STENCIL_TEST)
+        bit = filter_bit(slot)
+        GL.glStencilMask(bit)
+        GL.glStencilFunc(GL.GL_NOTEQUAL, bit, COUNTER_MASK)   # bit & 0x0F == 0: count != 0
+        GL.glStencilOp(GL.GL_KEEP, GL.GL_KEEP, GL.GL_REPLACE)
+        set_uniform(self.program, "u_clip_from_world", np.eye(4, dtype=np.float32).tobytes())
+        self._quad_vao.render(moderngl.TRIANGLES)
+        GL.glStencilOp(GL.GL_KEEP, GL.GL_KEEP, GL.GL_KEEP)
+        target.fbo.color_mask = (True, True, True, True)
+        target.fbo.use()
+
+    def stencil_off(self) -> None:
+        GL = _gl()
+        _ = self.ctx.error
+        GL.glDisable(GL.GL_STENCIL_TEST)
+        GL.glStencilMask(0xFF)
+
+    # ------------------------------------------------------------ teaching overlays
+    def heatmap(self) -> None:
+        """Blend a heat-map color over every covered pixel by its current stencil count
+        (depth writes are still off from :meth:`count`)."""
+        GL = _gl()
+        ctx = self.ctx
+        ctx.enable_only(moderngl.BLEND)
+        ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
+        _ = ctx.error
+        GL.glEnable(GL.GL_STENCIL_TEST)
+        GL.glStencilMask(0x00)
+        GL.glStencilOp(GL.GL_KEEP, GL.GL_KEEP, GL.GL_KEEP)
+        ctx.enable(moderngl.DEPTH_TEST)  # the quad sits at depth 1: only covered pixels pass
+        ctx.depth_func = ">"
+        identity = np.eye(4, dtype=np.float32).tobytes()
+        set_uniform(self.program, "u_clip_from_world", identity)
+        for level in range(1, HEAT_LEVELS + 1):
+            if level < HEAT_LEVELS:
+                GL.glStencilFunc(GL.GL_EQUAL, level, 0xFF)
+            else:  # 8 and above (a count of -1 wraps to 255 and shows here too)
+                GL.glStencilFunc(GL.GL_LEQUAL, level, 0xFF)
+            set_uniform(self.program, "u_color", heat_color(level))
+            self._quad_vao.render(moderngl.TRIANGLES)
+        ctx.depth_func = "<"
+        self.stencil_off()
+
+    def draw_translucent(self, view, volumes: list[CasterVolume]) -> None:
+        """Draw the volumes themselves, translucent, depth-tested against the scene."""
+        GL = _gl()
+        ctx = self.ctx
+        ctx.enable_only(moderngl.DEPTH_TEST | moderngl.BLEND)
+        ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
+        _ = ctx.error
+        GL.glDisable(GL.GL_STENCIL_TEST)
+        GL.glEnable(GL.GL_DEPTH_CLAMP)
+        set_uniform(self.program, "u_clip_from_world", gl_matrix(view.clip_from_world))
+        set_uniform(self.program, "u_color", VOLUME_COLOR)
+        for caster in volumes:
+            caster.vao.render(moderngl.TRIANGLES)
+        GL.glDisable(GL.GL_DEPTH_CLAMP)
+
+    def draw_silhouettes(self, view, volumes: list[CasterVolume]) -> None:
+        """Silhouette edges as lines, on top of everything."""
+        ctx = self.ctx
+        ctx.enable_only(moderngl.NOTHING)
+        _ = ctx.error
+        _gl().glDisable(_gl().GL_STENCIL_TEST)
+        set_uniform(self.program, "u_clip_from_world", gl_matrix(view.clip_from_world))
+        set_uniform(self.program, "u_color", SILHOUETTE_COLOR)
+        for caster in volumes:
+            if len(caster.volume.silhouette):  # open casters: their contour edges
+                caster.line_vao.render(moderngl.LINES)
+
+    def release(self) -> None:
+        self.release_volumes()
+        self._quad_vao.release()
+        self._quad_vbo.release()
+        self.program.release()
+
+
+def shadow_masks(renderer, scene: Scene, target, shading: str | None = None) -> np.ndarray:
+    """(L, H, W) bool, row 0 at the top: True where light i's stencil count is non-zero
+    (S_i = 0) on the frame just drawn. For tests and the viewer's inspection."""
+    view = renderer.render(scene, target, shading)
+    lights = scene.active_lights()
+    gpu_meshes = renderer.sync(scene)
+    shadows = renderer.shadow_volumes
+    masks = []
+    for index, light in enumerate(lights):
+        shadows.count(target, view, shadows.volumes(scene, gpu_meshes, index, light),
+                      scene.render.shadow_method)
+        masks.append(target.read_stencil() != 0)
+    shadows.stencil_off()
+    target.fbo.depth_mask = True
+    target.fbo.use()
+    return np.array(masks).reshape(len(lights), target.size[1], target.size[0])
