@@ -54,9 +54,9 @@ def run_scenario_main(scenarios: dict, name: str, out_dir: str, preset: str = "c
                       window_size: tuple[int, int] = (1280, 720), **options) -> int:
     """The script side: open the viewer on ``preset`` and run ``scenarios[f"scenario_{name}"]``
     under the test engine; ``options`` go to :class:`ViewerOptions`."""
+    from shadelab.lab.state import AppState
     from shadelab.scene import load_preset
     from shadelab.ui.app import ViewerOptions, run_viewer
-    from shadelab.ui.state import AppState
 
     scenario = scenarios[f"scenario_{name}"]
     out: dict = {}

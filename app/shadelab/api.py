@@ -383,7 +383,7 @@ def probe(scene: Scene | str, pixel: tuple[int, int], size: Any = (800, 600),
     if specular is not None and specular not in SPECULAR_MODELS:
         raise ShadeLabError(f"specular '{specular}': expected one of "
                             f"{', '.join(SPECULAR_MODELS)}")
-    from shadelab.ui.probe import probe as run_probe  # pure numpy, no GL
+    from shadelab.lab.probe import probe as run_probe  # pure numpy, no GL
 
     result = run_probe(scene, wh, (x, y), shading, specular)
     if result is None:
@@ -433,7 +433,7 @@ def show(scene: Scene | str, window: Any = (1600, 900), frames: int = 0,
     """
     import os
 
-    from shadelab.cli.view import NO_DISPLAY
+    from shadelab.ui.display import NO_DISPLAY
 
     scene = _scene(scene)
     if not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
@@ -449,8 +449,8 @@ def show(scene: Scene | str, window: Any = (1600, 900), frames: int = 0,
 
     scene = copy.deepcopy(scene)
     scene_meshes(scene)  # a broken mesh file fails here, with its one-line reason
+    from shadelab.lab.state import AppState
     from shadelab.ui.app import ViewerOptions, run_viewer
-    from shadelab.ui.state import AppState
 
     state = AppState.from_scene(scene, scene.name or "script")
     options = ViewerOptions(frames=frames, screenshot=shot, window_size=wh, autosave=autosave)

@@ -117,7 +117,7 @@ def test_cycle_finder_reports_a_cycle():
 GL = ("moderngl", "OpenGL", f"{PACKAGE}.gl", f"{PACKAGE}.raster")
 # The viewer's GL side: the shell that owns the window, the viewport's passes, the queue's
 # server and the pipelines' viewport drawing. Every other ui module (panels, state, jobs...)
-# reaches the GPU only through ``state.gpu`` (shadelab.ui.gpu_queue).
+# reaches the GPU only through ``state.gpu`` (shadelab.lab.gpu_queue).
 GL_SIDE = tuple(f"{PACKAGE}.ui.{m}" for m in ("app", "viewport", "gpu_side", "pipeline_viewport"))
 
 
@@ -164,10 +164,10 @@ def test_app_state_holds_no_gl_object():
     """AppState, its sub-states and what the panels queue for the GPU: no ``gl`` field and no
     field whose type is a GL object (a moderngl, shadelab.gl, shadelab.raster or GL-side
     class)."""
-    from shadelab.ui.gpu_queue import GpuQueue, Request, Texture
-    from shadelab.ui.pipeline_view import PipelineView
+    from shadelab.lab.gpu_queue import GpuQueue, Request, Texture
+    from shadelab.lab.pipeline_view import PipelineView
+    from shadelab.lab.state import SUB_STATES, AppState
     from shadelab.ui.radiosity_view import RadiosityView
-    from shadelab.ui.state import SUB_STATES, AppState
 
     bad = []
     for cls in (AppState, *SUB_STATES.values(), GpuQueue, Request, Texture, PipelineView,
@@ -202,3 +202,37 @@ def test_every_markdown_file_the_code_cites_is_in_the_repository():
     assert "ARCHITECTURE.md" in cited
     missing = {name: str(path) for name, path in cited.items() if not (repo / name).is_file()}
     assert not missing
+
+
+# ---------------------------------------------------------------- lab/: the viewer without GUI
+
+VIEWER_LOGIC = ("lab",)
+
+
+def test_the_viewer_logic_imports_no_gl_gui_or_ui_module():
+    """lab/ (state, session, lessons, jobs, probe, recorder...) imports no GL or GUI library and
+    no gl, raster, ui, bench or cli module, not even lazily: the API and the CLI may import it
+    without a window. (The study runner starts ``shadelab.studies`` experiments as jobs.)"""
+    bad = []
+    for name, path in modules().items():
+        if not any(is_under(name, f"{PACKAGE}.{p}") for p in VIEWER_LOGIC):
+            continue
+        for target, _, line in imported(name, path):
+            forbidden = [lib for lib in GL_GUI if is_under(target, lib)] + \
+                [up for up in UPPER if up != "studies" and is_under(target, f"{PACKAGE}.{up}")]
+            if forbidden:
+                bad.append(f"{path.relative_to(ROOT)}:{line}: imports {target}")
+    assert not bad, "lab/ imports GL, GUI or an upper layer:\n" + "\n".join(sorted(set(bad)))
+
+
+def test_only_ui_imports_imgui():
+    """imgui_bundle and glfw are imported by ui/ alone (the bench's viewer subprocess drives the
+    viewer through its command line)."""
+    bad = []
+    for name, path in modules().items():
+        if is_under(name, f"{PACKAGE}.ui"):
+            continue
+        for target, _, line in imported(name, path):
+            if is_under(target, "imgui_bundle") or is_under(target, "glfw"):
+                bad.append(f"{path.relative_to(ROOT)}:{line}: imports {target}")
+    assert not bad, "imgui outside ui/:\n" + "\n".join(sorted(set(bad)))

@@ -517,7 +517,7 @@ def _children(pid: int) -> list[int]:
 
 VIEWER_STANDIN = '''
 import os, sys, time
-from shadelab.ui.jobs import WorkerProcess
+from shadelab.lab.jobs import WorkerProcess
 import slowjob
 w = WorkerProcess()
 w.ensure()
@@ -548,7 +548,8 @@ def test_offline_worker_never_outlives_the_viewer(tmp_path, how):
     import signal
 
     (tmp_path / "slowjob.py").write_text(SLOWJOB)
-    env = {**os.environ, "PYTHONPATH": str(tmp_path)}
+    path = os.pathsep.join(filter(None, [str(tmp_path), os.environ.get("PYTHONPATH")]))
+    env = {**os.environ, "PYTHONPATH": path}
     proc = subprocess.Popen([sys.executable, "-c", VIEWER_STANDIN, how], env=env,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     worker = int(proc.stdout.readline())

@@ -101,7 +101,7 @@ def test_save_reload_broken_file_and_autosave(xdisplay, tmp_path):
     assert r["saved_kd"] == 0.25 and r["reloaded_kd"] == 0.25
     assert r["title_dirty"].endswith("*") and not r["title_saved"].endswith("*")
     assert "bad.toml" in r["broken_error"] and r["kd_after_broken"] == 0.25
-    from shadelab.ui.session import load_session
+    from shadelab.lab.session import load_session
 
     autosaved = load_session()  # the scenario's state folder (conftest: tmp_path / "state")
     assert autosaved.note == "" and autosaved.scene.materials["white"].kd == 0.25
@@ -237,7 +237,7 @@ def scenario_probe_click(ctx, state, out: dict) -> None:
     total = terms.emission + terms.ambient + sum(t.diffuse + t.specular for t in terms.lights)
     out["sum_of_terms"] = total.tolist()
     out["material"] = p.hit.mesh.material
-    from shadelab.ui import overlays
+    from shadelab.lab import overlays
 
     out["arrows"] = len(overlays.probe_arrows(p, 1.0)) // 10  # 5 segments (10 ends) each
     capture(ctx, str(Path(OUT_DIR) / "probe.png"))
@@ -287,8 +287,8 @@ def scenario_save_reload(ctx, state, out: dict) -> None:
 def scenario_jobs(ctx, state, out: dict) -> None:
     import threading
 
+    from shadelab.lab.jobs import JobKind, available_jobs
     from shadelab.progress import Progress
-    from shadelab.ui.jobs import JobKind, available_jobs
 
     closed = threading.Event()
 

@@ -205,8 +205,8 @@ def scenario_raytrace_pipeline(ctx, state, out: dict) -> None:
 
 
 def scenario_follow_edits(ctx, state, out: dict) -> None:
+    from shadelab.lab.pipeline_jobs import pipeline_raytrace
     from shadelab.ui import pipelines
-    from shadelab.ui.pipeline_jobs import pipeline_raytrace
 
     state.render_scale = 0.3
     ctx.yield_(3)
@@ -232,8 +232,9 @@ def scenario_follow_edits(ctx, state, out: dict) -> None:
 
 
 def scenario_radiosity_resolve(ctx, state, out: dict) -> None:
+    from shadelab.lab import pipeline_jobs
     from shadelab.radiosity.patches import uniform_patches
-    from shadelab.ui import pipeline_jobs, pipelines
+    from shadelab.ui import pipelines
 
     ctx.yield_(3)
     _open_algorithms(ctx)

@@ -62,7 +62,7 @@ def test_presenter_layout_cuts_nothing_off(bigdisplay, tmp_path, name):
 
 
 def test_lesson_walks_forward_and_back(bigdisplay, tmp_path):
-    from shadelab.ui.lesson import load_lesson
+    from shadelab.lab.lesson import load_lesson
 
     lesson = load_lesson("phong-to-radiosity")
     r = _run("lesson_walk", bigdisplay, tmp_path)
@@ -233,12 +233,12 @@ def scenario_layout_1920(ctx, state, out: dict) -> None:
 def scenario_lesson_walk(ctx, state, out: dict) -> None:
     from imgui_bundle import imgui
 
-    from shadelab.ui.lesson import LessonRun, go_to, load_lesson
+    from shadelab.lab.lesson import LessonRun, go_to, load_lesson
 
     state.lesson = LessonRun(load_lesson("phong-to-radiosity"))
     go_to(state, 0)
     ctx.yield_(3)
-    from shadelab.ui.lesson_file import SHOW_TOGGLES
+    from shadelab.lab.lesson_file import SHOW_TOGGLES
 
     presets, captions, indices, errors, toggles = [], [], [], [], []
     for i in range(len(state.lesson.lesson.steps)):

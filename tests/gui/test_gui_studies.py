@@ -1,6 +1,6 @@
 """The viewer's Studies and Failure gallery panels.
 
-Unit tests of :mod:`shadelab.ui.studies` (no window), then two GUI scenarios on the real viewer
+Unit tests of :mod:`shadelab.lab.studies` (no window), then two GUI scenarios on the real viewer
 under a private Xvfb (the ``xdisplay`` fixture and helpers of tests/gui/test_gui.py), each in its
 own process like the scenarios there.
 
@@ -27,15 +27,15 @@ SCENARIO_TIMEOUT = 60  # seconds per scenario process
 
 
 def _state(preset: str = "cornell"):
+    from shadelab.lab.state import AppState
     from shadelab.scene import load_preset
-    from shadelab.ui.state import AppState
 
     return AppState.from_scene(load_preset(preset), preset)
 
 
 def test_load_case_scene_applies_overrides_and_the_raster_shading():
+    from shadelab.lab.studies import case_shading, load_case_scene, offline_job_of
     from shadelab.studies.gallery import case_named
-    from shadelab.ui.studies import case_shading, load_case_scene, offline_job_of
 
     scene = load_case_scene(case_named("flat-curved"))
     assert scene.render.shading == "flat" and scene.objects[0].subdivisions == 2
@@ -47,8 +47,8 @@ def test_load_case_scene_applies_overrides_and_the_raster_shading():
 
 
 def test_open_case_replaces_the_scene_like_open_preset():
+    from shadelab.lab.studies import open_case
     from shadelab.studies.gallery import case_named
-    from shadelab.ui.studies import open_case
 
     state = _state()
     state.scene.materials["white"].kd = 0.3
@@ -70,8 +70,8 @@ def test_open_case_replaces_the_scene_like_open_preset():
 
 
 def test_a_broken_case_shows_the_error_and_keeps_the_scene():
+    from shadelab.lab.studies import open_case
     from shadelab.studies.gallery import GalleryCase
-    from shadelab.ui.studies import open_case
 
     state = _state()
     scene = state.scene
@@ -95,7 +95,7 @@ def _toy_result(**kwargs):
 
 
 def test_plot_series_groups_rows_and_floors_zero_errors_on_a_log_axis():
-    from shadelab.ui.studies import plot_series
+    from shadelab.lab.studies import plot_series
 
     series = {name: (xs, ys, labels) for name, xs, ys, labels in plot_series(_toy_result())}
     assert list(series) == ["a", "b"]
@@ -106,7 +106,7 @@ def test_plot_series_groups_rows_and_floors_zero_errors_on_a_log_axis():
 
 
 def test_auto_quality_picks_the_cheapest_front_point_within_the_budget():
-    from shadelab.ui.studies import auto_quality_line, study_front
+    from shadelab.lab.studies import auto_quality_line, study_front
 
     result = _toy_result()
     front = study_front(result)
@@ -124,8 +124,8 @@ def test_study_run_takes_the_result_or_the_error(monkeypatch):
     import time
 
     import shadelab.studies
-    from shadelab.ui.jobs import JobRunner
-    from shadelab.ui.studies import StudyRun
+    from shadelab.lab.jobs import JobRunner
+    from shadelab.lab.studies import StudyRun
 
     def wait(run):
         deadline = time.perf_counter() + 10
@@ -244,7 +244,7 @@ def scenario_gallery(ctx, state, out: dict) -> None:
 
 
 def scenario_studies(ctx, state, out: dict) -> None:
-    from shadelab.ui.studies import auto_quality_line
+    from shadelab.lab.studies import auto_quality_line
 
     ctx.yield_(3)
     ctx.window_focus("//Studies")

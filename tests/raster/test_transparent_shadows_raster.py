@@ -111,8 +111,8 @@ def test_transparent_casters_past_the_slots_cast_no_shadow(gl_ctx):
 
 
 def _probe_against_gpu(scene, size, pixels):
+    from shadelab.lab.probe import probe
     from shadelab.raster.offscreen import render_image
-    from shadelab.ui.probe import probe
 
     image = render_image(scene, size)
     out = []

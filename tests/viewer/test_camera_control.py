@@ -1,4 +1,4 @@
-"""Camera control (shadelab.ui.camera_control) against closed forms: orbit turns pi per
+"""Camera control (shadelab.lab.camera_control) against closed forms: orbit turns pi per
 viewport height, pan moves 2 d tan(fov/2) per viewport height, zoom scales by 0.9 per notch."""
 
 from __future__ import annotations
@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
+from shadelab.lab.camera_control import CLICK_SLOP, ORBIT_SPEED, ZOOM_STEP, drag, orbit, pan, zoom
 from shadelab.scene.model import Camera
-from shadelab.ui.camera_control import CLICK_SLOP, ORBIT_SPEED, ZOOM_STEP, drag, orbit, pan, zoom
 
 
 def _camera() -> Camera:

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 from types import SimpleNamespace
 
+from shadelab.lab.state import AppState
 from shadelab.scene import load_preset
 from shadelab.ui.followups import FollowUps, ViewerOptions, open_gallery_case
-from shadelab.ui.state import AppState
 
 
 def _state(**job):

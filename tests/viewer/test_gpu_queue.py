@@ -1,4 +1,4 @@
-"""The panels' way to the GPU: plain data queued in ``state.gpu`` (shadelab.ui.gpu_queue) and
+"""The panels' way to the GPU: plain data queued in ``state.gpu`` (shadelab.lab.gpu_queue) and
 served by the viewer's GL side (shadelab.ui.gpu_side) once per frame."""
 
 from __future__ import annotations
@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from shadelab.lab.gpu_queue import GpuQueue, Texture
 from shadelab.scene import load_preset
-from shadelab.ui.gpu_queue import GpuQueue, Texture
 
 # ---------------------------------------------------------------- the queue (no GL)
 

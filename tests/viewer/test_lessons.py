@@ -10,9 +10,9 @@ from pathlib import Path
 import pytest
 
 from shadelab.errors import ShadeLabError
+from shadelab.lab.lesson import SHOW_TOGGLES, LessonRun, go_to, list_lessons, load_lesson
+from shadelab.lab.state import AppState
 from shadelab.scene import load_preset
-from shadelab.ui.lesson import SHOW_TOGGLES, LessonRun, go_to, list_lessons, load_lesson
-from shadelab.ui.state import AppState
 
 GOOD_STEP = '[[steps]]\ntitle = "Ambient"\ncaption = "I = Ia ka"\npreset = "lecture"\n'
 

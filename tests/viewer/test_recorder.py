@@ -1,4 +1,4 @@
-"""The frame recorder (shadelab.ui.recorder): bench phases, per-phase frame figures, the
+"""The frame recorder (shadelab.lab.recorder): bench phases, per-phase frame figures, the
 ``--bench-json`` file. No window: frames are fed by hand."""
 
 from __future__ import annotations
@@ -7,7 +7,7 @@ import json
 
 import pytest
 
-from shadelab.ui.recorder import IDLE, INTERACTIVE, REDRAW, WARM_UP_FRAMES, FrameRecorder
+from shadelab.lab.recorder import IDLE, INTERACTIVE, REDRAW, WARM_UP_FRAMES, FrameRecorder
 
 
 def test_bench_phases_split_the_frames_in_thirds():

@@ -14,10 +14,10 @@ from pathlib import Path
 
 import pytest
 
+from shadelab.lab import session as session_mod
+from shadelab.lab.session import autosave_path, load_session, move_aside, save_session
 from shadelab.scene.model import Object
 from shadelab.scene.preset import load_preset, scene_to_dict
-from shadelab.ui import session as session_mod
-from shadelab.ui.session import autosave_path, load_session, move_aside, save_session
 
 TETRA = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
 
@@ -176,7 +176,7 @@ def test_a_killed_writers_stale_temporary_is_swept_a_live_one_kept():
 WRITER = r"""
 import sys
 from shadelab.scene.preset import load_preset
-from shadelab.ui.session import save_session
+from shadelab.lab.session import save_session
 tag, count = sys.argv[1], int(sys.argv[2])
 scene = load_preset("cornell")
 for i in range(count):

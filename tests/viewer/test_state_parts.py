@@ -1,12 +1,12 @@
-"""AppState's typed sub-states (shadelab.ui.state): the panels' old attribute names read and
+"""AppState's typed sub-states (shadelab.lab.state): the panels' old attribute names read and
 write the sub-state fields; no name is claimed twice; defaults are the sub-states' own."""
 
 from __future__ import annotations
 
 from dataclasses import fields
 
+from shadelab.lab.state import SUB_STATES, AppState
 from shadelab.scene import load_preset
-from shadelab.ui.state import SUB_STATES, AppState
 
 
 def _state() -> AppState:

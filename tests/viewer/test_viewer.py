@@ -9,13 +9,13 @@ import numpy as np
 import pytest
 
 from shadelab.cli import main
+from shadelab.lab.camera_control import orbit, pan, zoom
+from shadelab.lab.jobs import JobRunner, difference, iter_reference_raster
+from shadelab.lab.probe import probe
+from shadelab.lab.state import AppState, History, autosave_path, load_session, save_session
 from shadelab.progress import Progress
 from shadelab.scene import load_preset
 from shadelab.scene.preset import scene_to_dict
-from shadelab.ui.camera_control import orbit, pan, zoom
-from shadelab.ui.jobs import JobRunner, difference, iter_reference_raster
-from shadelab.ui.probe import probe
-from shadelab.ui.state import AppState, History, autosave_path, load_session, save_session
 
 # ---------------------------------------------------------------- command line
 
@@ -272,7 +272,7 @@ def test_job_runs_to_the_end_and_reports_errors():
 
 
 def test_available_jobs_lists_every_renderer_with_a_reason_when_missing():
-    from shadelab.ui.jobs import available_jobs
+    from shadelab.lab.jobs import available_jobs
 
     kinds = available_jobs()
     labels = [k.label for k in kinds]
@@ -283,7 +283,7 @@ def test_available_jobs_lists_every_renderer_with_a_reason_when_missing():
 
 
 def test_legend_is_burned_into_the_bottom_band():
-    from shadelab.ui.legend import burn_legend, legend_lines
+    from shadelab.lab.legend import burn_legend, legend_lines
 
     state = AppState.from_scene(load_preset("cornell"), "cornell")
     image = np.full((200, 300, 3), 128, np.uint8)
@@ -297,7 +297,7 @@ def test_legend_is_burned_into_the_bottom_band():
 def test_overlays_ray_tree_and_radiosity_soup_shapes_and_colors():
     from types import SimpleNamespace
 
-    from shadelab.ui import overlays
+    from shadelab.lab import overlays
 
     node = SimpleNamespace
     leaf = node(kind="shadow", origin=np.zeros(3), direction=np.array([0.0, 1.0, 0.0]),
@@ -318,7 +318,7 @@ def test_overlays_ray_tree_and_radiosity_soup_shapes_and_colors():
 
 def test_wireframe_and_normal_glyphs_follow_the_mesh():
     from shadelab.geometry.mesh import scene_meshes
-    from shadelab.ui import overlays
+    from shadelab.lab import overlays
 
     meshes = scene_meshes(load_preset("cornell"))
     faces = sum(len(m.faces) for m in meshes)
@@ -357,7 +357,7 @@ def test_view_restores_the_autosaved_session_unless_fresh_or_another_preset(tmp_
 
 
 def test_a_picklable_job_runs_in_the_worker_process_and_cancels():
-    from shadelab.ui.jobs import iter_reference_raster
+    from shadelab.lab.jobs import iter_reference_raster
 
     scene = load_preset("cornell")
     runner = JobRunner()
@@ -432,8 +432,8 @@ def test_save_never_overwrites_a_shipped_preset(tmp_path, monkeypatch):
 
 def slow_stages(scene, size):
     """A picklable job: a step, then a stage longer than the runner's KILL_AFTER, then more."""
+    from shadelab.lab.jobs import KILL_AFTER
     from shadelab.progress import Progress
-    from shadelab.ui.jobs import KILL_AFTER
 
     yield Progress(None, 0.1, "stage 1")
     time.sleep(KILL_AFTER + 1.0)

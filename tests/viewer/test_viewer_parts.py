@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 from PIL import Image
 
+from shadelab.lab import autosave as autosave_module
+from shadelab.lab.autosave import Autosave
+from shadelab.lab.state import AUTOSAVE_INTERVAL, AppState, autosave_path
 from shadelab.scene import load_preset
-from shadelab.ui import autosave as autosave_module
-from shadelab.ui.autosave import Autosave
-from shadelab.ui.state import AUTOSAVE_INTERVAL, AppState, autosave_path
 from shadelab.ui.viewport_reads import update_probe, write_viewport_screenshot
 
 

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from pathlib import Path
 
@@ -12,9 +11,7 @@ from shadelab.scene.preset import scene_to_dict
 
 DEFAULT_PRESET = "lecture"
 DEFAULT_WINDOW = "1600x900"  # the window's size before it is maximized
-NO_DISPLAY = ("no display (DISPLAY and WAYLAND_DISPLAY are unset): run under xvfb-run "
-              "(install Xvfb; 'xvfb-run -a shadelab'), or use 'shadelab render PRESET -o "
-              "OUT.png'")
+from shadelab.ui.display import NO_DISPLAY, check_display  # noqa: E402,F401
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -66,28 +63,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(run=run_view)
 
 
-def check_display() -> None:
-    """One line, before any window code, when no display can be opened (unset, or naming a
-    server that is not there): GLFW's own failure ends in an ImGui assertion."""
-    if not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
-        raise ShadeLabError(NO_DISPLAY)
-    import glfw
-
-    glfw.ERROR_REPORTING = "ignore"
-    try:
-        ok = glfw.init()
-    except Exception:  # noqa: BLE001 - any failure of the probe means no usable display
-        ok = False
-    if not ok:
-        where = os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
-        raise ShadeLabError(f"no display: cannot open '{where}'; run under xvfb-run, or use "
-                            "shadelab render")
-    glfw.terminate()
-
-
 def check_job(name: str) -> None:
     """--job names an offline renderer (a prefix of its label), checked before the window."""
-    from shadelab.ui.jobs import available_jobs
+    from shadelab.lab.jobs import available_jobs
 
     labels = [kind.label for kind in available_jobs()]
     if not name.strip() or not any(label.lower().startswith(name.lower()) for label in labels):
@@ -137,8 +115,8 @@ def load_scene(args: argparse.Namespace, notes: list[str] | None = None):
 
     A damaged session never stops the viewer: it is moved aside and what was wrong is
     appended to ``notes`` (and printed), for the status line."""
+    from shadelab.lab.state import load_session
     from shadelab.scene.preset import load_preset
-    from shadelab.ui.state import load_session
 
     if not args.fresh and not args.set:
         session = load_session()
@@ -159,7 +137,7 @@ def _restored_meshes_or_preset(args: argparse.Namespace, scene, source: str,
     """A restored session whose mesh file no longer reads (damaged since) falls back to the
     preset, the session kept aside; any other scene's broken mesh is the usual one-line error."""
     from shadelab.geometry.mesh import scene_meshes
-    from shadelab.ui.session import autosave_path, move_aside
+    from shadelab.lab.session import autosave_path, move_aside
 
     try:
         scene_meshes(scene)
@@ -193,7 +171,7 @@ def run_view(args: argparse.Namespace) -> int:
         raise ShadeLabError(f"--frames {args.frames}: expected a count >= 0")
     _check_study_and_case(args)
     if args.pipeline:
-        from shadelab.ui.pipeline_jobs import PIPELINE_NAMES
+        from shadelab.lab.pipeline_jobs import PIPELINE_NAMES
 
         if args.pipeline not in PIPELINE_NAMES:
             raise ShadeLabError(f"--pipeline '{args.pipeline}': expected one of "
@@ -203,7 +181,7 @@ def run_view(args: argparse.Namespace) -> int:
     if args.step != 1 and not args.lesson:
         raise ShadeLabError(f"--step {args.step}: only with --lesson NAME")
     if args.lesson:
-        from shadelab.ui.lesson import LessonRun, load_lesson, step_scene
+        from shadelab.lab.lesson import LessonRun, load_lesson, step_scene
 
         run = LessonRun(load_lesson(args.lesson))  # every step checked: one-line error
         steps = len(run.lesson.steps)
@@ -221,8 +199,8 @@ def run_view(args: argparse.Namespace) -> int:
     else:
         scene_meshes(scene)  # a broken mesh file fails here, with its one-line reason
     check_display()  # after the input: a bad flag or preset is named even without a display
+    from shadelab.lab.state import AppState
     from shadelab.ui.app import ViewerOptions, run_viewer
-    from shadelab.ui.state import AppState
 
     state = AppState.from_scene(scene, source)
     if restored:
@@ -236,7 +214,7 @@ def run_view(args: argparse.Namespace) -> int:
     state.presenter, state.show_help = args.presenter, args.help_overlay
     state.show_wireframe, state.show_normals = args.wireframe, args.normals
     if run is not None:   # after the view flags: the step's own toggles (show = [...]) win
-        from shadelab.ui.lesson import go_to
+        from shadelab.lab.lesson import go_to
 
         state.lesson = run
         go_to(state, args.step - 1)

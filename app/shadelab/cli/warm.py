@@ -20,7 +20,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from shadelab.ui.pipeline_jobs import warm_kernels
+    from shadelab.lab.pipeline_jobs import warm_kernels
 
     start = time.perf_counter()
     count = warm_meshes()

@@ -16,28 +16,30 @@ import numpy as np
 from imgui_bundle import hello_imgui, imgui, immapp
 
 from shadelab.geometry.mesh import geometry_key, scene_meshes
-from shadelab.ui import (
+from shadelab.lab import (
     camera_control,
+    lesson,
+    overlays,
+)
+from shadelab.lab.autosave import Autosave
+from shadelab.lab.recorder import FrameRecorder
+from shadelab.lab.state import (
+    AppState,
+)
+from shadelab.ui import (
     compare_view,
     gizmos,
     layout,
-    lesson,
-    overlays,
     panels,
     pipeline_viewport,
     pipelines,
     presenter,
     radiosity_view,
 )
-from shadelab.ui.autosave import Autosave
 from shadelab.ui.followups import FollowUps, ViewerOptions, write_window_screenshot
 from shadelab.ui.frame import guarded
 from shadelab.ui.offline import draw_offline_panel
-from shadelab.ui.recorder import FrameRecorder
 from shadelab.ui.render_panel import draw_algorithms_panel
-from shadelab.ui.state import (
-    AppState,
-)
 from shadelab.ui.studies_panel import draw_gallery_panel, draw_studies_panel
 from shadelab.ui.viewport_reads import update_probe, write_viewport_screenshot
 

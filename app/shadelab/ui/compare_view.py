@@ -6,8 +6,8 @@ from __future__ import annotations
 
 from imgui_bundle import imgui
 
-from shadelab.ui import camera_control
-from shadelab.ui.state import COMPARE_LABELS, COMPARE_VIEWS, AppState
+from shadelab.lab import camera_control
+from shadelab.lab.state import COMPARE_LABELS, COMPARE_VIEWS, AppState
 
 
 def draw_compare(viewer, size: tuple[int, int]) -> None:

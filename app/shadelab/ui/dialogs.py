@@ -15,7 +15,7 @@ from imgui_bundle import imgui
 from imgui_bundle import portable_file_dialogs as pfd
 
 from shadelab.geometry.mesh import MESH_SUFFIXES
-from shadelab.ui.state import AppState
+from shadelab.lab.state import AppState
 
 BACKEND = pfd
 PRESET_FILTER = ["Presets (.toml)", "*.toml"]

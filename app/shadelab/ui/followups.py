@@ -11,8 +11,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Callable
 
+from shadelab.lab.state import AppState
 from shadelab.ui import pipelines
-from shadelab.ui.state import AppState
 
 
 @dataclass
@@ -39,8 +39,8 @@ class ViewerOptions:
 
 def open_gallery_case(state: AppState, name: str) -> None:
     """``--gallery NAME``: select the failure-gallery case and open it in the viewer."""
+    from shadelab.lab.studies import open_case
     from shadelab.studies.gallery import GALLERY
-    from shadelab.ui.studies import open_case
 
     names = [case.name for case in GALLERY]
     if name not in names:

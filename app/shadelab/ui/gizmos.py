@@ -14,8 +14,8 @@ import math
 import numpy as np
 from imgui_bundle import imgui, imguizmo
 
+from shadelab.lab.state import AppState
 from shadelab.scene.camera import clip_from_view, tan_half_fov_y, view_from_world
-from shadelab.ui.state import AppState
 
 GIZMO = imguizmo.im_guizmo
 GIZMO_SIZE = 0.12            # ImGuizmo's size, share of clip space

@@ -1,4 +1,4 @@
-"""The viewer's GL side of :class:`shadelab.ui.gpu_queue.GpuQueue` (GL thread only).
+"""The viewer's GL side of :class:`shadelab.lab.gpu_queue.GpuQueue` (GL thread only).
 
 Once per frame, before the panels draw, :meth:`GpuSide.flush` uploads the images the panels
 queued (textures registered by id and size) and runs their requests on the viewer's
@@ -11,7 +11,7 @@ from typing import Callable
 
 import numpy as np
 
-from shadelab.ui.gpu_queue import GpuQueue, Texture
+from shadelab.lab.gpu_queue import GpuQueue, Texture
 from shadelab.ui.viewport import Viewport
 
 

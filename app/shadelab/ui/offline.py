@@ -7,12 +7,12 @@ import threading
 import numpy as np
 from imgui_bundle import imgui
 
+from shadelab.lab.jobs import available_jobs, difference
+from shadelab.lab.state import AppState
 from shadelab.scene.preset import clone_scene
 from shadelab.shading.conventions import heat_map, to_srgb8
 from shadelab.ui import panels
-from shadelab.ui.jobs import available_jobs, difference
 from shadelab.ui.pipelines import object_label
-from shadelab.ui.state import AppState
 
 SIZES = (32, 64, 96, 128, 192, 256, 384, 512, 768, 1024)
 SAMPLES = (1, 4, 16, 64, 256)
@@ -117,7 +117,7 @@ def _take_solution(state: AppState, latest) -> None:
     """Keep a radiosity solution's display triangles (drawn in the viewport on request)."""
     solution = latest.stats.get("solution") if latest.stats else None
     if solution is not None and hasattr(solution, "display_meshes"):
-        from shadelab.ui.overlays import radiosity_soup
+        from shadelab.lab.overlays import radiosity_soup
 
         state.radiosity_soup = radiosity_soup(solution.display_meshes())
         state.overlay_version += 1

@@ -1,6 +1,6 @@
 """The viewer's panels: each ``draw_<x>_panel(state) -> bool`` (True when it edited the scene).
 
-Panels only read and write :class:`shadelab.ui.state.AppState`; GL work is asked for through it
+Panels only read and write :class:`shadelab.lab.state.AppState`; GL work is asked for through it
 (``state.probe_requested``, ``state.screenshot_requested``) and done by :mod:`shadelab.ui.app`.
 """
 
@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 from imgui_bundle import imgui, implot
 
+from shadelab.lab.state import COMPARE_LABELS, AppState
 from shadelab.scene.model import (
     ATTENUATION_MODES,
     LIGHT_KINDS,
@@ -28,7 +29,6 @@ from shadelab.shading import reference
 from shadelab.ui import dialogs
 from shadelab.ui.layout import plot_size, same_line_if_fits
 from shadelab.ui.ranges import field_slider, intensity_range
-from shadelab.ui.state import COMPARE_LABELS, AppState
 
 ERROR_COLOR = imgui.ImVec4(1.0, 0.35, 0.3, 1.0)
 DIM_COLOR = imgui.ImVec4(0.65, 0.65, 0.65, 1.0)
@@ -125,7 +125,7 @@ def save_here(state: AppState) -> None:
 def draw_lesson_row(state: AppState) -> None:
     """Pick a shipped lesson (its Prev / Next buttons sit under the viewport's caption;
     PageUp / PageDown do the same); (none) ends it and keeps the scene."""
-    from shadelab.ui import lesson
+    from shadelab.lab import lesson
 
     run = state.lesson
     current = "" if run is None else Path(run.lesson.path).stem

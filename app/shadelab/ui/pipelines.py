@@ -7,7 +7,7 @@ resolution: ray and path tracing coarse first (1/8, 1/4, 1/2, full) and refined 
 radiosity shot by shot as Gouraud triangles under the live camera. Any edit the image depends
 on restarts the job from coarse: the running one is cancelled without waiting, the new one
 starts on the first frame the worker is free, and until its first image arrives the last
-image stays up. Jobs run in a worker process of their own (:class:`shadelab.ui.jobs.JobRunner`),
+image stays up. Jobs run in a worker process of their own (:class:`shadelab.lab.jobs.JobRunner`),
 so the UI never waits for them.
 """
 
@@ -21,17 +21,20 @@ from pathlib import Path
 import numpy as np
 from imgui_bundle import imgui
 
+from shadelab.lab import pipeline_jobs
+from shadelab.lab.pipeline_view import (  # noqa: F401  (the viewer reads them here too)
+    LABELS,
+    PIPELINES,
+    RASTER,
+    PipelineView,
+    current,
+    set_pipeline,
+    sync,
+    view_of,
+)
+from shadelab.lab.state import AppState
 from shadelab.scene.preset import clone_scene
-from shadelab.ui import pipeline_jobs
-from shadelab.ui.pipeline_view import PipelineView
-from shadelab.ui.state import AppState
 
-PIPELINES = pipeline_jobs.PIPELINE_NAMES
-LABELS = {"gouraud": "z-buffer + Gouraud", "phong": "z-buffer + Phong",
-          "painter": "list priority + Phong", "radiosity": "radiosity + Gouraud",
-          "raytrace": "ray tracing (Whitted)", "pathtrace": "path tracing (reference)"}
-RASTER = {"gouraud": ("gouraud", "zbuffer"), "phong": ("phong", "zbuffer"),
-          "painter": ("phong", "painter")}
 OFFLINE = {"raytrace": pipeline_jobs.pipeline_raytrace,
            "pathtrace": pipeline_jobs.pipeline_pathtrace,
            "radiosity": pipeline_jobs.pipeline_radiosity}
@@ -75,47 +78,6 @@ class JobRecord:
                 "first_image_s": self.first_image_s, "done_s": self.done_s,
                 **({} if self.reused_form_factors is None
                    else {"form_factors_reused": self.reused_form_factors})}
-
-
-def view_of(state: AppState) -> PipelineView:
-    if state.pipeline_view is None:
-        state.pipeline_view = PipelineView()
-    return state.pipeline_view
-
-
-def current(state: AppState) -> str:
-    """The pipeline shown: ``state.pipeline``, or the raster one the scene's settings name."""
-    if state.pipeline in PIPELINES:
-        return state.pipeline
-    render = state.scene.render
-    if render.visibility == "painter":
-        return "painter"
-    return "gouraud" if render.shading == "gouraud" else "phong"
-
-
-def set_pipeline(state: AppState, name: str) -> None:
-    """Switch the viewport's pipeline (the panel, the CLI's --pipeline and lessons call it)."""
-    if name not in PIPELINES:
-        state.error = f"pipeline '{name}': expected one of {', '.join(PIPELINES)}"
-        return
-    state.pipeline = name
-    sync(state)
-
-
-def sync(state: AppState) -> None:
-    """Write a newly chosen raster pipeline into the scene (once per choice)."""
-    view = view_of(state)
-    name = state.pipeline
-    if name in RASTER and view.applied != name:
-        shading, visibility = RASTER[name]
-        render = state.scene.render
-        if (render.shading, render.visibility) != (shading, visibility):
-            render.shading, render.visibility = shading, visibility
-            state.mark_edited()
-    view.applied = name
-
-
-# ---------------------------------------------------------------- jobs
 
 
 def job_key(state: AppState, name: str, size: tuple[int, int]) -> tuple:
@@ -400,7 +362,7 @@ def draw_ray_tree(state: AppState, draw_list, origin, display_size) -> None:
     view = view_of(state)
     scene = view.job_scene
     from shadelab.geometry.mesh import scene_meshes
-    from shadelab.ui.overlays import scene_diagonal
+    from shadelab.lab.overlays import scene_diagonal
 
     miss = 0.3 * scene_diagonal(scene_meshes(scene))
     segments = tree_segments(view.ray_tree, miss, view.tree_depth)

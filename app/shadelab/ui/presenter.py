@@ -10,8 +10,8 @@ from __future__ import annotations
 
 from imgui_bundle import hello_imgui, imgui
 
+from shadelab.lab.state import AppState
 from shadelab.ui.layout import same_line_if_fits
-from shadelab.ui.state import AppState
 
 PRESENTER_SCALE = 1.8          # font scale of presenter mode (ui/app.py applies it)
 LINE_PX = 1.5                  # overlay line width at font scale 1, pixels
@@ -272,7 +272,7 @@ def draw_lesson_buttons(state: AppState, origin, size, band: float) -> None:
     reach whichever panel a step brings forward (PageUp / PageDown do the same)."""
     if band <= 0 or not lesson_running(state):
         return
-    from shadelab.ui import lesson
+    from shadelab.lab import lesson
 
     style = imgui.get_style()
     widths = [imgui.calc_text_size(label).x + 2 * style.frame_padding.x

@@ -150,7 +150,7 @@ def view_of(state) -> RadiosityView:
 
 
 def geometry_key(scene) -> tuple:
-    from shadelab.ui.pipeline_jobs import radiosity_key
+    from shadelab.lab.pipeline_jobs import radiosity_key
 
     return (radiosity_key(scene), scene.radiosity.hemicube_resolution)
 

@@ -13,6 +13,7 @@ from dataclasses import fields
 
 from imgui_bundle import imgui
 
+from shadelab.lab.state import AppState
 from shadelab.scene.model import (
     RADIOSITY_SOLVERS,
     TRANSPARENCY_MODELS,
@@ -21,7 +22,6 @@ from shadelab.scene.model import (
 )
 from shadelab.ui import pipelines
 from shadelab.ui.layout import plot_size
-from shadelab.ui.state import AppState
 
 ERROR_COLOR = imgui.ImVec4(1.0, 0.35, 0.3, 1.0)
 DIM_COLOR = imgui.ImVec4(0.65, 0.65, 0.65, 1.0)

@@ -1,7 +1,7 @@
 """The Studies panel (speed-vs-accuracy charts drawn live with ImPlot) and the Failure gallery.
 
 The logic (running a study off the UI thread, plot series, auto quality, opening a case) is in
-:mod:`shadelab.ui.studies`; this module only draws it.
+:mod:`shadelab.lab.studies`; this module only draws it.
 """
 
 from __future__ import annotations
@@ -11,10 +11,8 @@ import time
 import numpy as np
 from imgui_bundle import imgui, implot
 
-from shadelab.ui import panels
-from shadelab.ui.layout import plot_size
-from shadelab.ui.state import AppState
-from shadelab.ui.studies import (
+from shadelab.lab.state import AppState
+from shadelab.lab.studies import (
     StudyRun,
     auto_quality_line,
     cell,
@@ -23,6 +21,8 @@ from shadelab.ui.studies import (
     plot_series,
     study_front,
 )
+from shadelab.ui import panels
+from shadelab.ui.layout import plot_size
 
 SPINNER = "|/-\\"
 PLOT_LINES = 14.0   # plot height in text lines (grows with the font)

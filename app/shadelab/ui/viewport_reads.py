@@ -3,8 +3,8 @@ value beside its CPU reference, and the viewport screenshot (the S key)."""
 
 from __future__ import annotations
 
-from shadelab.ui.probe import probe
-from shadelab.ui.state import AppState
+from shadelab.lab.probe import probe
+from shadelab.lab.state import AppState
 
 
 def update_probe(state: AppState, viewport, size: tuple[int, int],
@@ -43,7 +43,7 @@ def write_viewport_screenshot(state: AppState, viewport, path: str) -> None:
     a failed write is one line in ``state.error``."""
     from PIL import Image
 
-    from shadelab.ui.legend import burn_legend
+    from shadelab.lab.legend import burn_legend
 
     image = viewport.read_display("main")
     if state.legend_in_screenshot:

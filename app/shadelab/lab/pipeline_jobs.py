@@ -1,7 +1,7 @@
 """The offline pipelines of the viewport as worker-process jobs (pure: numpy, no GL, no GUI).
 
 Each factory ``f(scene, size)`` yields :class:`shadelab.progress.Progress` and pickles by
-reference, so :class:`shadelab.ui.jobs.JobRunner` runs it in its worker process:
+reference, so :class:`shadelab.lab.jobs.JobRunner` runs it in its worker process:
 
 * ray tracing and path tracing render coarse first: 1/8 of the viewport's resolution, then
   1/4, 1/2 and full, each a complete picture, refined in place;
@@ -23,7 +23,6 @@ from shadelab.progress import Progress
 from shadelab.scene.model import Scene
 from shadelab.scene.preset import clone_scene
 
-PIPELINE_NAMES = ("gouraud", "phong", "painter", "radiosity", "raytrace", "pathtrace")
 LEVELS = (8, 4, 2, 1)        # resolution divisors, coarse to fine
 RADIOSITY_CHUNK_S = 0.05     # seconds of shooting between two radiosity updates
 _RADIOSITY_CACHE: dict = {}  # worker process: geometry key -> (patches, form factors, token)

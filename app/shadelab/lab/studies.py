@@ -3,7 +3,7 @@ turn its result into plot series and an auto-quality choice, open a gallery case
 
 Pure module (threads, processes and numpy only; no GL, no imgui): :mod:`shadelab.ui.studies_panel`
 draws it. A study renders with its own headless GL context, so it runs in a worker *process*
-(:class:`shadelab.ui.jobs.JobRunner`), never next to the viewer's window context.
+(:class:`shadelab.lab.jobs.JobRunner`), never next to the viewer's window context.
 """
 
 from __future__ import annotations
@@ -13,8 +13,8 @@ from dataclasses import dataclass, field
 from typing import Iterator
 
 from shadelab.errors import ShadeLabError
+from shadelab.lab.jobs import JobRunner
 from shadelab.progress import Progress
-from shadelab.ui.jobs import JobRunner
 
 OFFLINE_JOB_OF_METHOD = {"raytrace": "Whitted", "pathtrace": "Path", "radiosity": "Radiosity"}
 

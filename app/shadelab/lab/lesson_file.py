@@ -1,5 +1,5 @@
 """Lesson files and the walk through them: :class:`Step`, :class:`Lesson`, :func:`load_lesson`
-and :class:`LessonRun` (data only: no state, no GL, no GUI). :mod:`shadelab.ui.lesson` shows
+and :class:`LessonRun` (data only: no state, no GL, no GUI). :mod:`shadelab.lab.lesson` shows
 the steps in the viewer; the file format is described there."""
 
 from __future__ import annotations

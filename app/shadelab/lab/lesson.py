@@ -23,7 +23,7 @@ from __future__ import annotations
 from shadelab.errors import ShadeLabError
 
 # The file format and the walk (data only), re-exported where the viewer has always found them
-from shadelab.ui.lesson_file import (  # noqa: F401
+from shadelab.lab.lesson_file import (  # noqa: F401
     SHOW_TOGGLES,
     STEP_KEYS,
     Lesson,
@@ -70,13 +70,10 @@ def apply_pipeline(state, name: str) -> None:
     fall back to the scene's shading mode."""
     if not name:
         return
-    try:
-        from shadelab.ui import pipelines
-    except ImportError:
-        pipelines = None
-    if pipelines is not None and hasattr(state, "pipeline") \
-            and name in getattr(pipelines, "PIPELINES", ()):
-        pipelines.set_pipeline(state, name)
+    from shadelab.lab import pipeline_view
+
+    if name in pipeline_view.PIPELINES:
+        pipeline_view.set_pipeline(state, name)
         return
     if name in ("flat", "gouraud", "phong"):
         state.scene.render.shading = name

@@ -6,7 +6,7 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
-from shadelab.ui.state import AUTOSAVE_INTERVAL, AppState, save_session
+from shadelab.lab.state import AUTOSAVE_INTERVAL, AppState, save_session
 
 
 @dataclass

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
-from shadelab.ui.state import AppState
+from shadelab.lab.state import AppState
 
 
 def legend_lines(state: AppState) -> list[str]:

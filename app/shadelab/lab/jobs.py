@@ -289,8 +289,8 @@ def iter_reference_raster(scene: Scene, size: tuple[int, int], rows_per_chunk: i
     Always available: it checks the GPU image pixel for pixel and exercises the job panel.
     """
     from shadelab.geometry.mesh import scene_meshes
+    from shadelab.lab.probe import Picker, _facing
     from shadelab.shading.reference import normalize, shade
-    from shadelab.ui.probe import Picker, _facing
 
     scene = clone_scene(scene)
     width, height = size

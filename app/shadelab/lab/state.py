@@ -3,7 +3,7 @@ lesson), plus undo history and the autosaved session.
 
 Pure module (no GL, no GUI): the panels read and write an :class:`AppState`; the GL side keeps
 its resources elsewhere (:mod:`shadelab.ui.viewport`, :mod:`shadelab.ui.gpu_side`). What the
-panels ask of the GPU goes through ``AppState.gpu``, a :class:`shadelab.ui.gpu_queue.GpuQueue`
+panels ask of the GPU goes through ``AppState.gpu``, a :class:`shadelab.lab.gpu_queue.GpuQueue`
 of numpy images, requests and plain results.
 """
 
@@ -14,29 +14,29 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from shadelab.errors import ShadeLabError
-from shadelab.scene.model import Camera, Scene
-from shadelab.scene.preset import clone_scene, load_preset, save_preset, scene_to_dict
-from shadelab.ui.gpu_queue import GpuQueue
+from shadelab.lab.gpu_queue import GpuQueue
 
 # One file, written atomically; a damaged one is moved aside and never stops the viewer
-# (shadelab.ui.session). Re-exported here, where the viewer has always found them.
-from shadelab.ui.session import (  # noqa: F401
+# (shadelab.lab.session). Re-exported here, where the viewer has always found them.
+from shadelab.lab.session import (  # noqa: F401
     SessionLoad,
     autosave_path,
     load_session,
     save_session,
     state_dir,
 )
+from shadelab.scene.model import Camera, Scene
+from shadelab.scene.preset import clone_scene, load_preset, save_preset, scene_to_dict
 
 if TYPE_CHECKING:  # types only (no import at run time: the GL side stays out of this module)
     import numpy as np
 
+    from shadelab.lab.jobs import JobKind, JobRunner
+    from shadelab.lab.lesson_file import LessonRun
+    from shadelab.lab.pipeline_view import PipelineView
+    from shadelab.lab.probe import ProbeResult
+    from shadelab.lab.studies import StudyRun
     from shadelab.raytrace.tree import RayNode
-    from shadelab.ui.jobs import JobKind, JobRunner
-    from shadelab.ui.lesson_file import LessonRun
-    from shadelab.ui.pipeline_view import PipelineView
-    from shadelab.ui.probe import ProbeResult
-    from shadelab.ui.studies import StudyRun
 
 COMPARE_VIEWS = (("flat", "phong"), ("gouraud", "phong"), ("phong", "phong"), ("phong", "blinn"))
 COMPARE_LABELS = ("Flat", "Gouraud", "Phong", "Blinn-Phong")
@@ -139,7 +139,7 @@ class ViewState:
 
 @dataclass
 class ProbeState:
-    """The probed pixel and what the probe found there (shadelab.ui.probe)."""
+    """The probed pixel and what the probe found there (shadelab.lab.probe)."""
 
     probe_pixel: tuple[int, int] | None = None
     probe: ProbeResult | None = None
@@ -158,7 +158,7 @@ class JobState:
     job_spp: int = 16                 # samples per pixel (path tracer; Whitted anti-aliasing)
     job_compare: dict | None = None   # error figures vs the raster view
     job_raster: np.ndarray | None = None  # (H, W, 3) raster image the job is compared with
-    job_kinds: list[JobKind] | None = None  # shadelab.ui.jobs.available_jobs(), on first use
+    job_kinds: list[JobKind] | None = None  # shadelab.lab.jobs.available_jobs(), on first use
     job_version: int = -1             # the JobRunner version last uploaded
     job_scene: Scene | None = None    # the Scene snapshot the last job rendered
     job_size_px: tuple = (0, 0)       # its image size (width, height)
@@ -184,7 +184,7 @@ class StudyState:
 
 @dataclass
 class LessonState:
-    """The lesson walked through with PageDown / PageUp (shadelab.ui.lesson)."""
+    """The lesson walked through with PageDown / PageUp (shadelab.lab.lesson)."""
 
     lesson: LessonRun | None = None
     focus_request: str = ""           # panels to bring to the front next frame (a,b,...)
@@ -249,7 +249,7 @@ class AppState:
 
     @classmethod
     def from_scene(cls, scene: Scene, source: str, **kwargs) -> "AppState":
-        from shadelab.ui.jobs import JobRunner
+        from shadelab.lab.jobs import JobRunner
 
         state = cls(scene=scene, source=source)
         for name, value in kwargs.items():  # a sub-state's field, by its old name, too
@@ -319,7 +319,7 @@ class AppState:
         """Open a preset or add a mesh; with unsaved edits, replacing the scene asks first
         (``pending_open``, answered by :func:`shadelab.ui.dialogs.draw_discard_question`)."""
         from shadelab.geometry.mesh import MESH_SUFFIXES
-        from shadelab.ui.lesson_file import is_lesson_file, load_lesson
+        from shadelab.lab.lesson_file import is_lesson_file, load_lesson
 
         if not self.dirty or Path(path).suffix.lower() in MESH_SUFFIXES:
             self.open_file(path)
@@ -338,7 +338,7 @@ class AppState:
         """A preset (.toml or a name) replaces the scene, a lesson file starts its walk at the
         first step; a mesh file is added to the scene."""
         from shadelab.geometry.mesh import MESH_SUFFIXES
-        from shadelab.ui.lesson_file import is_lesson_file
+        from shadelab.lab.lesson_file import is_lesson_file
 
         if Path(path).suffix.lower() in MESH_SUFFIXES:
             return self.add_mesh(path)
@@ -348,9 +348,9 @@ class AppState:
 
     def open_lesson(self, path: str) -> bool:
         """Walk the lesson in ``path`` (PageDown / PageUp): the viewer shows its first step at
-        the frame's end (:func:`shadelab.ui.lesson.go_to`); a broken lesson is one line and
+        the frame's end (:func:`shadelab.lab.lesson.go_to`); a broken lesson is one line and
         keeps the scene."""
-        from shadelab.ui.lesson_file import LessonRun, load_lesson
+        from shadelab.lab.lesson_file import LessonRun, load_lesson
 
         try:
             lesson = load_lesson(path)
