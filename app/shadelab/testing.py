@@ -60,6 +60,23 @@ class Threshold:
     max_share: float
     max_rmse: float
 
+    def __post_init__(self) -> None:
+        import math
+
+        def number(value) -> bool:
+            return isinstance(value, (int, float)) and not isinstance(value, bool) \
+                and math.isfinite(value)
+
+        if not (isinstance(self.pixel, int) and not isinstance(self.pixel, bool)
+                and 0 <= self.pixel <= 255):
+            raise ShadeLabError(f"threshold pixel {self.pixel!r}: expected an int in [0, 255]")
+        if not (number(self.max_share) and 0.0 <= self.max_share <= 1.0):
+            raise ShadeLabError(f"threshold max_share {self.max_share!r}: expected a number "
+                                "in [0, 1]")
+        if not (number(self.max_rmse) and 0.0 <= self.max_rmse <= 255.0):
+            raise ShadeLabError(f"threshold max_rmse {self.max_rmse!r}: expected a number in "
+                                "[0, 255]")
+
 
 #: Named thresholds. ``golden``: ShadeLab's own golden images (blessed on Mesa llvmpipe; a GPU
 #: driver rounds differently on a few edge pixels); ``exact``: identical images only;
@@ -76,6 +93,9 @@ THRESHOLDS: dict[str, Threshold] = {
 def threshold_of(threshold: str | Threshold) -> Threshold:
     if isinstance(threshold, Threshold):
         return threshold
+    if not isinstance(threshold, str):
+        raise ShadeLabError(f"threshold {threshold!r}: expected one of "
+                            f"{', '.join(THRESHOLDS)} or a Threshold")
     if threshold not in THRESHOLDS:
         raise ShadeLabError(f"threshold '{threshold}': expected one of "
                             f"{', '.join(THRESHOLDS)} or a Threshold")
@@ -97,29 +117,89 @@ def as_srgb8(image: Any, exposure: float | None = None):
 
     from shadelab.shading.conventions import to_srgb8
 
+    exposure = _exposure(exposure)
     if isinstance(image, (str, Path)):
-        from PIL import Image as PILImage
-
-        path = Path(image)
-        if not path.is_file():
-            raise ShadeLabError(f"{path}: image file not found")
-        with PILImage.open(path) as im:
-            return np.asarray(im.convert("RGB"))
+        return _read_png(Path(image))
     if hasattr(image, "array") and hasattr(image, "exposure"):
+        _check_finite(image.array)
         return to_srgb8(image.array, image.exposure if exposure is None else exposure)
-    a = np.asarray(image)
+    try:
+        a = np.asarray(image)
+    except (TypeError, ValueError) as exc:
+        raise ShadeLabError(f"image: not an array ({exc})") from None
     if a.ndim != 3 or a.shape[2] not in (3, 4):
         raise ShadeLabError(f"image: expected an (H, W, 3) array, got shape {a.shape}")
     a = a[..., :3]
     if a.dtype == np.uint8:
         return np.ascontiguousarray(a)
+    if a.dtype.kind != "f":
+        raise ShadeLabError(f"image: expected uint8 (sRGB) or float (linear radiance), got "
+                            f"{a.dtype}")
+    _check_finite(a)
     return to_srgb8(a.astype(np.float32), 1.0 if exposure is None else exposure)
 
 
-def _save(array, path: Path) -> None:
+def _exposure(exposure: Any) -> float | None:
+    import math
+
+    if exposure is None:
+        return None
+    if isinstance(exposure, bool) or not isinstance(exposure, (int, float)) \
+            or not math.isfinite(exposure) or exposure <= 0:
+        raise ShadeLabError(f"exposure {exposure!r}: expected a finite number > 0")
+    return float(exposure)
+
+
+def _check_finite(a) -> None:
+    """NaN or Inf radiance is a wrong image, never one equal to its reference."""
+    import numpy as np
+
+    bad = int(np.count_nonzero(~np.isfinite(a)))
+    if bad:
+        raise AssertionError(f"image: {bad} NaN or infinite values (radiance must be finite)")
+
+
+def _read_png(path: Path):
+    """An image file as sRGB uint8, inside Pillow's guards: missing, fake, truncated and
+    decompression-bomb files are one line."""
+    import numpy as np
     from PIL import Image as PILImage
 
-    PILImage.fromarray(array).save(path)
+    if not path.is_file():
+        raise ShadeLabError(f"{path}: image file not found")
+    try:
+        with PILImage.open(path) as im:
+            return np.asarray(im.convert("RGB"))
+    except PILImage.DecompressionBombError as exc:
+        raise ShadeLabError(f"{path}: image too large to read ({exc})") from None
+    except (OSError, ValueError, SyntaxError) as exc:  # UnidentifiedImageError is an OSError
+        reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise ShadeLabError(f"{path}: not a readable image ({reason})") from None
+
+
+def _save(array, path: Path) -> None:
+    """Write a PNG through a temporary file beside it: a full disk or a read-only folder is
+    one line, and never leaves a half-written reference."""
+    import tempfile
+
+    from PIL import Image as PILImage
+
+    if path.is_dir():
+        raise ShadeLabError(f"{path}: is a folder, not an image file")
+    tmp = None
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".png.tmp", dir=path.parent)
+        with os.fdopen(fd, "wb") as out:
+            PILImage.fromarray(array).save(out, format="PNG")
+        os.replace(tmp, path)
+        tmp = None
+    except OSError as exc:
+        raise ShadeLabError(f"{path}: cannot write ({exc.strerror or exc})") from None
+    finally:
+        if tmp is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
 
 
 def assert_images_close(actual: Any, expected: Any, threshold: str | Threshold = "golden", *,
@@ -168,7 +248,6 @@ def assert_images_close(actual: Any, expected: Any, threshold: str | Threshold =
     if regenerate is None:
         regenerate = regenerate_requested()
     if ref_path is not None and regenerate:
-        ref_path.parent.mkdir(parents=True, exist_ok=True)
         _save(img, ref_path)
         return {"regenerated": str(ref_path)}
     if ref_path is not None and not ref_path.is_file():
@@ -184,33 +263,122 @@ def assert_images_close(actual: Any, expected: Any, threshold: str | Threshold =
     figures = {"share": share, "rmse": rmse, "max_diff": int(diff.max(initial=0))}
     if share > limit.max_share or rmse > limit.max_rmse:
         folder = Path(output_dir or os.environ.get(OUTPUT_ENV) or "shadelab-image-diffs")
-        folder.mkdir(parents=True, exist_ok=True)
-        _save(img, folder / f"{name}_img.png")
-        _save(ref, folder / f"{name}_ref.png")
-        _save(np.clip(diff * 16, 0, 255).astype(np.uint8), folder / f"{name}_diff.png")
+        try:
+            _save(img, folder / f"{name}_img.png")
+            _save(ref, folder / f"{name}_ref.png")
+            _save(np.clip(diff * 16, 0, 255).astype(np.uint8), folder / f"{name}_diff.png")
+            where = f"see {folder / name}_{{img,ref,diff}}.png"
+        except ShadeLabError as exc:
+            where = f"no difference images ({exc})"
         label = threshold if isinstance(threshold, str) else "custom"
+        hint = _likeliest_term(actual, img)
         raise AssertionError(
             f"{name}: {share:.2%} of pixels differ by > {limit.pixel}/255 (allowed "
             f"{limit.max_share:.2%}), RMSE {rmse:.2f}/255 (allowed {limit.max_rmse}), "
-            f"threshold '{label}'; see {folder / name}_{{img,ref,diff}}.png")
+            f"threshold '{label}'; {where}" + (f"\n{hint}" if hint else ""))
     return figures
+
+
+# ---------------------------------------------------------------- which term is wrong
+
+#: The lecture's terms, each as (what the student may have got wrong, how the reference is
+#: re-rendered to show it). A failed comparison of a :func:`render_with_shaders` image renders
+#: each variant with ShadeLab's own shaders and names the one the image matches best.
+TERM_VARIANTS = (
+    ("the ambient term Ia·ka·Od (left out)", "ambient"),
+    ("the diffuse term kd·Od·(N·L) (left out)", "diffuse"),
+    ("the specular term ks·Os·(R·V)^n (left out)", "specular"),
+    ("the attenuation f_att (taken as 1)", "f_att"),
+    ("the shadow factor S_i (taken as 1: no shadows)", "shadow"),
+    ("the specular model (Phong's (R·V)^n and Blinn's (N·H)^n swapped)", "model"),
+)
+
+
+def _variant(scene, which: str, specular: str):
+    """A copy of ``scene`` with one term of the equation changed; the specular model used."""
+    from shadelab.scene.preset import clone_scene
+
+    scene = clone_scene(scene)
+    if which == "ambient":
+        scene.Ia = (0.0, 0.0, 0.0)
+    elif which in ("diffuse", "specular"):
+        for material in scene.materials.values():
+            setattr(material, "kd" if which == "diffuse" else "ks", 0.0)
+    elif which == "f_att":
+        for light in scene.lights:
+            light.attenuation = "none"
+    elif which == "shadow":
+        scene.render.shadows = "none"
+    elif which == "model":
+        specular = "blinn" if specular == "phong" else "phong"
+    return scene, specular
+
+
+def likeliest_term(image: Any) -> tuple[str, float, float] | None:
+    """For an image from :func:`render_with_shaders`: (the term whose change explains the
+    difference best, RMSE of the image to that variant, RMSE to the full equation), both in
+    sRGB 8-bit levels, or None when no variant comes within half the full equation's RMSE
+    (or the image does not say what it was rendered from)."""
+    import numpy as np
+
+    source = getattr(image, "_source", None)
+    if source is None:
+        return None
+    from shadelab.api import render
+
+    scene, size, shading, specular = source
+    specular = specular or scene.render.specular
+    img = as_srgb8(image).astype(np.float64)
+
+    def rmse(scene_, specular_) -> float:
+        ref = as_srgb8(render(scene_, size=size, shading=shading, specular=specular_))
+        return float(np.sqrt(np.mean((img - ref) ** 2)))
+
+    full = rmse(scene, specular)
+    scores = [(rmse(*_variant(scene, which, specular)), label)
+              for label, which in TERM_VARIANTS]
+    best, label = min(scores)
+    if best >= 0.5 * full:
+        return None
+    return label, best, full
+
+
+def _likeliest_term(actual: Any, img) -> str:
+    try:
+        found = likeliest_term(actual)
+    except ShadeLabError:
+        return ""
+    if found is None:
+        return ""
+    label, best, full = found
+    return (f"likeliest wrong term: {label}: the image is within RMSE {best:.2f}/255 of the "
+            f"reference rendered that way, {full:.2f}/255 from the lecture's equation")
 
 
 # ---------------------------------------------------------------- students' shaders
 
 
+#: A replaced include starts at line LINE_BASE * (k + 1) + 1 (``#line``), k its index: the
+#: compiler's log then tells the student's own line numbers apart from ShadeLab's (drivers do
+#: not all report the source-string number of ``#line``, but every one reports the line).
+LINE_BASE = 100000
+
+
 @contextlib.contextmanager
 def _includes_replaced(replacements: dict[str, str]):
-    """While active, programs compile with these include texts instead of ShadeLab's."""
+    """While active, programs compile with these include texts instead of ShadeLab's. Each
+    text starts with a ``#line`` after ShadeLab's generated header, so an error in it is
+    reported at the line of the student's file (see :func:`_student_lines`)."""
     from shadelab.gl import programs
 
     original = programs.register_includes
 
     def register(ctx) -> None:
         original(ctx)
-        for key, text in replacements.items():
+        for index, (key, text) in enumerate(sorted(replacements.items())):
             header = programs.GENERATED_HEADERS.get(key)
-            ctx.includes[key] = (header() if header else "") + text
+            ctx.includes[key] = (header() if header else "") + \
+                f"#line {LINE_BASE * (index + 1) + 1}\n" + text
 
     programs.register_includes = register
     try:
@@ -219,11 +387,18 @@ def _includes_replaced(replacements: dict[str, str]):
         programs.register_includes = original
 
 
-def _include_texts(includes: dict[str, str | Path]) -> dict[str, str]:
+def _include_texts(includes: dict[str, str | Path]) -> tuple[dict[str, str], dict[str, str]]:
+    """(include name -> GLSL text, include name -> how errors name it: the file or
+    ``<include NAME>``)."""
+    from collections.abc import Mapping
+
     from shadelab.resources import shaders_dir
 
+    if not isinstance(includes, Mapping) or not includes:
+        raise ShadeLabError(f"includes: expected a mapping of include name to GLSL text or "
+                            f"path, got {type(includes).__name__}")
     known = sorted(p.stem for p in (shaders_dir() / "include").glob("*.glsl"))
-    texts = {}
+    texts, names = {}, {}
     for key, source in includes.items():
         if key not in known:
             raise ShadeLabError(f"include '{key}': expected one of {', '.join(known)}")
@@ -232,11 +407,36 @@ def _include_texts(includes: dict[str, str | Path]) -> dict[str, str]:
             path = Path(source)
             try:
                 texts[key] = path.read_text(encoding="utf-8")
+            except UnicodeDecodeError:
+                raise ShadeLabError(f"{path}: shader is not UTF-8 text") from None
             except OSError as exc:
                 raise ShadeLabError(f"{path}: cannot read shader ({exc.strerror})") from None
+            names[key] = str(path)
+        elif isinstance(source, str):
+            texts[key], names[key] = source, f"<include {key}>"
         else:
-            texts[key] = str(source)
-    return texts
+            raise ShadeLabError(f"include '{key}': expected GLSL text or a .glsl path, got "
+                                f"{type(source).__name__}")
+    return texts, names
+
+
+def _student_lines(log: str, texts: dict[str, str], names: dict[str, str]) -> str:
+    """The compiler's ``N:LINE(COL)`` references (Mesa's format) rewritten as
+    ``file:LINE:COL`` for the lines of a replaced include."""
+    import re
+
+    keys = sorted(texts)
+
+    def where(match) -> str:
+        index, line = divmod(int(match.group(2)), LINE_BASE)
+        if not 1 <= index <= len(keys):
+            return match.group(0)
+        key = keys[index - 1]
+        if line <= texts[key].count("\n") + 1:
+            return f"{names[key]}:{line}:{match.group(3)}"
+        return f"ShadeLab's shader after {names[key]}"
+
+    return re.sub(r"\b(\d+):(\d+)\((\d+)\)", where, log)
 
 
 def render_with_shaders(scene: Any, includes: dict[str, str | Path], size: Any = (256, 256),
@@ -273,7 +473,7 @@ def render_with_shaders(scene: Any, includes: dict[str, str | Path], size: Any =
 
     scene = _scene(scene)
     wh = _size(size, "raster")
-    texts = _include_texts(includes)
+    texts, names = _include_texts(includes)
     ctx = headless_context()
     renderer = Renderer(ctx)  # its own program cache: the shared renderer stays untouched
     target = RenderTarget(ctx, wh)
@@ -282,14 +482,17 @@ def render_with_shaders(scene: Any, includes: dict[str, str | Path], size: Any =
             try:
                 renderer.render(scene, target, shading, specular)
             except moderngl.Error as exc:
-                raise AssertionError(f"the replaced shaders do not compile: {exc}") from None
+                raise AssertionError("the replaced shaders do not compile: "
+                                     f"{_student_lines(str(exc), texts, names)}") from None
         array = target.read()
     finally:
         renderer.release()
         target.release()
-    return Image(array, scene.render.exposure,
-                 {"pipeline": "raster", "shading": shading or scene.render.shading,
-                  "includes": sorted(texts)})
+    image = Image(array, scene.render.exposure,
+                  {"pipeline": "raster", "shading": shading or scene.render.shading,
+                   "includes": sorted(texts)})
+    image._source = (scene, wh, shading, specular)  # what likeliest_term re-renders
+    return image
 
 
 # ---------------------------------------------------------------- the pytest plugin

@@ -154,3 +154,131 @@ def test_golden_module_uses_the_package_thresholds():
 
     assert (golden.PIXEL_TOLERANCE, golden.MAX_DIFFERING_SHARE, golden.MAX_RMSE) == (2, 0.001,
                                                                                      1.0)
+
+
+# ---------------------------------------------------------------- an autograder's messages
+
+FORGETS_F_ATT = ("vec3 scale = s * f_att * spot * LIGHT_IP(i);",
+                 "vec3 scale = s * spot * LIGHT_IP(i);")
+BLINN_FOR_PHONG = ("else specular = phong_specular(n, to_light, to_eye, u_n);",
+                   "else specular = blinn_phong_specular(n, to_light, to_eye, u_n);")
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("mistake, term", [
+    (FORGETS_SPECULAR, "the specular term ks·Os·(R·V)^n"),
+    (FORGETS_F_ATT, "the attenuation f_att"),
+    (BLINN_FOR_PHONG, "the specular model"),
+])
+def test_a_failure_names_the_likeliest_wrong_term(gl_ctx, tmp_path, mistake, term):
+    import shadelab
+
+    reference = shadelab.render("lecture", size=(64, 48), shading="phong")
+    student = render_with_shaders("lecture", {"lighting": _student(mistake)}, size=(64, 48),
+                                  shading="phong")
+    with pytest.raises(AssertionError) as failure:
+        assert_images_close(student, reference, "golden", name="s", output_dir=tmp_path)
+    message = str(failure.value)
+    assert f"likeliest wrong term: {term}" in message, message
+    # the named variant explains the image (RMSE well under the full equation's)
+    best, full = (float(v) for v in
+                  __import__("re").findall(r"RMSE (\d+\.\d+)/255 of the reference rendered that "
+                                           r"way, (\d+\.\d+)/255", message)[0])
+    assert best < 0.5 * full
+
+
+@pytest.mark.gl
+def test_a_compile_error_names_the_students_file_and_line(gl_ctx, tmp_path):
+    path = tmp_path / "my_lighting.glsl"
+    text = LIGHTING.replace("return max(dot(n, to_light), 0.0);", "return nope;")
+    path.write_text(text)
+    line = text.splitlines().index(next(x for x in text.splitlines() if "nope" in x)) + 1
+    with pytest.raises(AssertionError, match=rf"{path}:{line}:\d+: error: `nope' undeclared"):
+        render_with_shaders("lecture", {"lighting": path}, size=16)
+    with pytest.raises(AssertionError, match=rf"<include lighting>:{line}:\d+: error"):
+        render_with_shaders("lecture", {"lighting": text}, size=16)
+
+
+# ---------------------------------------------------------------- misuse: one clear line
+
+
+@pytest.mark.parametrize("threshold, match", [
+    (["golden"], "threshold \\['golden'\\]: expected one of"),
+    (3, "threshold 3: expected one of"),
+])
+def test_a_threshold_of_the_wrong_type_is_one_line(threshold, match):
+    with pytest.raises(ShadeLabError, match=match):
+        assert_images_close(_gray(1), _gray(1), threshold)
+
+
+@pytest.mark.parametrize("fields, match", [
+    ((-1, 0.0, 0.0), "pixel -1"), ((2, -0.1, 1.0), "max_share -0.1"),
+    ((2, 0.1, float("nan")), "max_rmse nan"), ((2.5, 0.1, 1.0), "pixel 2.5"),
+])
+def test_a_custom_threshold_out_of_range_is_refused(fields, match):
+    from shadelab.testing import Threshold
+
+    with pytest.raises(ShadeLabError, match=match):
+        Threshold(*fields)
+    assert Threshold(0, 0.0, 0.0) == THRESHOLDS["exact"]
+
+
+def test_nan_images_never_pass_and_odd_dtypes_and_exposures_are_refused():
+    nan = np.full((4, 4, 3), np.nan, dtype=np.float32)
+    with pytest.raises(AssertionError, match="48 NaN or infinite values"):
+        assert_images_close(nan, nan.copy())
+    with pytest.raises(ShadeLabError, match="expected uint8 \\(sRGB\\) or float .* got int64"):
+        assert_images_close(np.zeros((4, 4, 3), np.int64), _gray(0, (4, 4)))
+    with pytest.raises(ShadeLabError, match="exposure '2': expected a finite number > 0"):
+        assert_images_close(_gray(0, (4, 4)), _gray(0, (4, 4)), exposure="2")
+
+
+def test_broken_reference_files_are_one_line(tmp_path):
+    fake = tmp_path / "fake.png"
+    fake.write_text("not a png")
+    noise = np.random.default_rng(2).integers(0, 256, (64, 64, 3), dtype=np.uint8)
+    good = tmp_path / "good.png"
+    PILImage.fromarray(noise).save(good)
+    cut = tmp_path / "cut.png"
+    cut.write_bytes(good.read_bytes()[:len(good.read_bytes()) // 2])
+    for path in (fake, cut):
+        with pytest.raises(ShadeLabError, match=f"{path.name}: not a readable image"):
+            assert_images_close(noise, path)
+    assert assert_images_close(noise, good)["rmse"] == 0.0
+
+
+def test_regenerating_onto_a_folder_or_under_a_file_is_one_line(tmp_path):
+    folder = tmp_path / "golden.png"
+    folder.mkdir()
+    with pytest.raises(ShadeLabError, match="is a folder, not an image file"):
+        assert_images_close(_gray(7, (8, 8)), folder, regenerate=True)
+    blocker = tmp_path / "not-a-folder"
+    blocker.write_text("a file where the golden folder should be")
+    with pytest.raises(ShadeLabError, match="not-a-folder/x.png: cannot write"):
+        assert_images_close(_gray(7, (8, 8)), blocker / "x.png", regenerate=True)
+    assert not list(tmp_path.rglob("*.tmp"))
+
+
+def test_regenerating_into_a_full_disk_is_one_line_and_leaves_nothing(tmp_path, monkeypatch):
+    import errno
+
+    from PIL import Image as PILModule
+
+    def full(self, fp, *args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(PILModule.Image, "save", full)
+    with pytest.raises(ShadeLabError, match="x.png: cannot write \\(No space left on device\\)"):
+        assert_images_close(_gray(7, (8, 8)), tmp_path / "x.png", regenerate=True)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_shader_mapping_of_the_wrong_kind_is_one_line(tmp_path):
+    with pytest.raises(ShadeLabError, match="includes: expected a mapping"):
+        render_with_shaders("lecture", ["lighting.glsl"], size=16)
+    with pytest.raises(ShadeLabError, match="include 'lighting': expected GLSL text or a .glsl"):
+        render_with_shaders("lecture", {"lighting": 5}, size=16)
+    latin = tmp_path / "latin.glsl"
+    latin.write_bytes(b"// caf\xe9\n")
+    with pytest.raises(ShadeLabError, match="latin.glsl: shader is not UTF-8 text"):
+        render_with_shaders("lecture", {"lighting": latin}, size=16)
