@@ -43,7 +43,8 @@ def machine() -> dict:
     except OSError:
         pass
     info = {"cpu": cpu, "cores": os.cpu_count(), "python": sys.version.split()[0],
-            "platform": platform.platform()}
+            "platform": platform.platform(),
+            "load_average_1min_at_start": round(os.getloadavg()[0], 2)}
     try:
         from shadelab.gl.context import context_info, headless_context
 
@@ -54,6 +55,17 @@ def machine() -> dict:
     except Exception as exc:  # the bench still reports CPU sections without GL
         info["gl_renderer"] = f"unavailable: {exc}"
     return info
+
+
+def summary(verdict: dict) -> str:
+    """One paragraph on stderr: how many goals were met, which failed, which were not
+    measured and why."""
+    met = sum(row["met"] for row in verdict["checked"])
+    lines = [f"bench: goals met {met} of {len(verdict['checked'])} checked"]
+    lines += [f"  failed: {row['goal']} ({row['bound']}; measured {row['value']:.3g})"
+              for row in verdict["checked"] if not row["met"]]
+    lines += [f"  not measured: {row['goal']}: {row['why']}" for row in verdict["unmeasured"]]
+    return "\n".join(lines)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -67,13 +79,19 @@ def run(args: argparse.Namespace) -> int:
             from shadelab.errors import ShadeLabError
 
             raise ShadeLabError(f"--only '{name}': expected one of {', '.join(sorted(known))}")
-    report = {"machine": machine(), "quick": bool(args.quick), "sections": {}}
+    from shadelab.bench import goals
+
+    report = {"machine": machine(), "quick": bool(args.quick), "peers": goals.peers(),
+              "sections": {}}
     for name, module_name in SECTIONS:
         if args.only and name not in args.only:
             continue
         module = importlib.import_module(module_name)
         print(f"bench: {name} ...", file=sys.stderr, flush=True)
         report["sections"][name] = module.run(bool(args.quick))
+    report["machine"]["load_average_1min_at_end"] = round(os.getloadavg()[0], 2)
+    report["meets_goals"] = verdict = goals.check(report["sections"], report["peers"])
+    print(summary(verdict), file=sys.stderr, flush=True)
     text = json.dumps(report, indent=2)
     if args.json:
         with open(args.json, "w", encoding="utf-8") as f:
