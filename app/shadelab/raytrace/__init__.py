@@ -3,6 +3,8 @@ tree of a pixel, and a reference Monte Carlo path tracer. Pure layer: no GL, no 
 
 import os
 
+from shadelab.environment import drop_bad_thread_counts
+
 BACKENDS = ("auto", "embree", "bvh")  # ray casting: auto = embree when embreex imports
 
 # numba's OpenMP threads sleep between the kernels' parallel loops instead of spinning: the
@@ -10,3 +12,6 @@ BACKENDS = ("auto", "embree", "bvh")  # ray casting: auto = embree when embreex 
 # cores (shared with other work) spinning threads take the cores from them. Read by the
 # OpenMP runtime when numba first starts it; a value already set is kept.
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
+# A thread count of 0 or "abc" would end numba's first parallel kernel in a traceback.
+drop_bad_thread_counts()
