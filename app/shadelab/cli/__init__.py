@@ -106,6 +106,11 @@ def main(argv: list[str] | None = None) -> int:
     except ShadeLabError as exc:
         print(f"shadelab: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except MemoryError as exc:  # numpy's _ArrayMemoryError names the size it asked for
+        what = str(exc).split(" for an array", 1)[0].strip() or "an allocation failed"
+        print(f"shadelab: error: not enough memory ({what}); try a smaller --size, fewer "
+              "samples or patches, or a smaller mesh", file=sys.stderr)
+        return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         print("shadelab: interrupted", file=sys.stderr)
         return 130
