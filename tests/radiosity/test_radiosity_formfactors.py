@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+from shadelab.errors import ShadeLabError
 from shadelab.radiosity.formfactors import (
     FormFactors,
     form_factor_matrix,
@@ -171,3 +172,22 @@ def test11_hemicube_without_a_backend_is_refused(squares):
         FormFactors(squares, "hemicube")
     with pytest.raises(ShadeLabError, match="GPU backend"):
         next(iter_radiosity(load_preset("cornell"), None, 20, "hemicube"))
+
+
+@pytest.mark.gl
+def test_a_hemicube_past_the_gl_limit_is_one_line(gl_ctx, tmp_path, capsys):
+    """hemicube_resolution 4096 (the schema's maximum): a 20480-px atlas that llvmpipe's
+    16384-px limit cannot hold; before, moderngl's 'framebuffer is not complete' traceback."""
+    from shadelab.cli import main
+    from shadelab.raster.hemicube import check_resolution, gl_size_limit
+
+    limit = gl_size_limit(gl_ctx)
+    check_resolution(gl_ctx, limit // 5 // 2 * 2)  # the largest that fits is accepted
+    with pytest.raises(ShadeLabError, match=f"exceed this GL's limit of {limit} px"):
+        check_resolution(gl_ctx, limit // 5 // 2 * 2 + 2)
+    out = tmp_path / "x.png"
+    code = main(["radiosity", "cornell", "-o", str(out), "--size", "16x16",
+                 "--form-factors", "hemicube", "--set", "radiosity.hemicube_resolution=4096"])
+    err = capsys.readouterr().err
+    assert code == 2 and "hemicube_resolution 4096" in err and "Traceback" not in err
+    assert not out.exists()

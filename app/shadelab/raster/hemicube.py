@@ -15,6 +15,7 @@ from __future__ import annotations
 import moderngl
 import numpy as np
 
+from shadelab.errors import ShadeLabError
 from shadelab.gl.context import headless_context
 from shadelab.gl.programs import load_program
 from shadelab.gl.target import bind_anchor
@@ -58,6 +59,23 @@ def tangent_frame(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return t, np.cross(n, t)
 
 
+def gl_size_limit(ctx: moderngl.Context) -> int:
+    """The widest texture, renderbuffer and viewport this GL draws (pixels)."""
+    return min(int(ctx.info.get("GL_MAX_TEXTURE_SIZE", 4096)),
+               int(ctx.info.get("GL_MAX_RENDERBUFFER_SIZE", 4096)),
+               int(ctx.info.get("GL_MAX_VIEWPORT_DIMS", (4096, 4096))[0]))
+
+
+def check_resolution(ctx: moderngl.Context, res: int) -> None:
+    """One line instead of moderngl's 'framebuffer is not complete' past the GL's limit (the
+    atlas lays a hemicube's five faces side by side)."""
+    limit = gl_size_limit(ctx)
+    if 5 * res > limit:
+        raise ShadeLabError(f"radiosity.hemicube_resolution {res}: the hemicube's five faces "
+                            f"({5 * res} px wide) exceed this GL's limit of {limit} px; use at "
+                            f"most {limit // 5 // 2 * 2}, or raycast form factors")
+
+
 class Hemicube:
     """Item-buffer hemicubes of a patch set; ``rows(indices)`` gives form-factor rows."""
 
@@ -73,6 +91,7 @@ class Hemicube:
             self.eyes, self.eye_w = receiver_samples(patches.polygons, order)
         self.res = max(2, int(resolution) // 2 * 2)
         self.ctx = ctx or headless_context()
+        check_resolution(self.ctx, self.res)
         self.program = load_program(self.ctx, "hemicube")
         self.batch = max(1, min(32, ATLAS_MAX // self.res))
         n = len(patches)
