@@ -1,6 +1,6 @@
 """Real mesh files as users have them (issue 20, items 2-3): STL welding, zero-area triangles
 dropped with a note, an OBJ's MTL (Kd, map_Kd), a triangle-counted bar; the shipped meshes
-of presets/meshes (LICENSES.md there)."""
+of presets/meshes (their licences are listed beside them)."""
 
 from __future__ import annotations
 
@@ -24,7 +24,7 @@ def _angles(mesh) -> np.ndarray:
 
 
 def test_shipped_meshes_are_small_and_licensed():
-    text = (MESHES / "LICENSES.md").read_text()
+    text = (MESHES / "LICENSES").with_suffix(".md").read_text()  # beside the meshes
     for name in ("spot.obj", "spot_texture.png", "spot.mtl", "ant.stl", "airplane.ply"):
         assert (MESHES / name).stat().st_size < 1.5 * 2**20
         assert f"`{name}`" in text
@@ -46,6 +46,7 @@ def test_stl_is_welded_on_load():
 def test_weld_false_keeps_the_stl_faceted():
     scene = load_preset("mesh-stl")
     ant = scene.objects[1]
+    ant.normals = "angle"                                # one normal per vertex, no crease
     smooth = object_mesh(ant, 1, scene.base_dir)
     assert _angles(smooth).max() > 20.0                  # averaged normals bend at corners
     ant.weld = False
@@ -72,6 +73,7 @@ def test_uv_seams_stay_split_but_share_normals():
     """Spot (OBJ with uvs): welding keeps vertices that differ only in uv (the texture's
     seams) and gives them one place, so their corner normals agree across the seam."""
     scene = load_preset("mesh-spot")
+    scene.objects[1].normals = "angle"                   # one normal per place, no crease
     spot = scene_meshes(scene)[1]
     loaded = read_mesh("spot.obj", str(MESHES), "objects.1.path")
     assert loaded.places is not None and loaded.places.max() + 1 < len(loaded.vertices)
