@@ -117,7 +117,7 @@ def _mesh_preset(tmp_path: Path, filename: str, content: str | bytes) -> str:
 @pytest.mark.parametrize("filename,content,expected", [
     ("notes.txt", "hello", "is not a mesh file"),
     ("empty.obj", "# nothing here\n", "empty mesh"),
-    ("degenerate.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n", "degenerate"),
+    ("degenerate.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 4 4 1\n", "degenerate"),
     ("garbage.stl", b"\x00\x01garbage" * 3, "mesh"),
 ])
 def test_bad_mesh_files(tmp_path, capsys, filename, content, expected):

@@ -204,7 +204,7 @@ def test11_degenerate_triangles(gl_ctx, shading):
 
 
 def test11b_degenerate_mesh_file_is_refused(tmp_path, capsys):
-    (tmp_path / "bad.obj").write_text("v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n")
+    (tmp_path / "bad.obj").write_text("v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 4 4 1\n")
     (tmp_path / "bad.toml").write_text(
         'schema_version = 1\n[[objects]]\nshape = "mesh"\npath = "bad.obj"\n')
     assert main(["validate", str(tmp_path / "bad.toml")]) == 2

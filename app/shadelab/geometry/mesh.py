@@ -6,8 +6,12 @@ show the same triangles.
 
 from __future__ import annotations
 
+import copy
 import math
-from dataclasses import dataclass
+import os
+import re
+import sys
+from dataclasses import dataclass, field
 from functools import cached_property, lru_cache
 from pathlib import Path
 
@@ -66,7 +70,7 @@ def geometry_key(obj: Object, base_dir: str) -> tuple:
     return (obj.shape, obj.path, base_dir, obj.radius, obj.minor_radius, obj.height,
             tuple(obj.extents), obj.size, tuple(map(tuple, obj.vertices)), obj.subdivisions,
             obj.sections, obj.segments, tuple(obj.translate), tuple(obj.rotate),
-            tuple(obj.scale), obj.normals, obj.crease_angle)
+            tuple(obj.scale), obj.normals, obj.crease_angle, obj.weld)
 
 
 def object_mesh(obj: Object, index: int = 0, base_dir: str = ".") -> MeshData:
@@ -99,19 +103,26 @@ def scene_bounds(meshes: list[MeshData]) -> np.ndarray:
 @lru_cache(maxsize=256)
 def _cached_mesh(key: tuple, shape: str, index: int):
     obj = _object_from_key(key)
-    vertices, faces, uvs = _local_mesh(obj, key[2], index)
+    vertices, faces, uvs, places = _local_mesh(obj, key[2], index)
     matrix = world_from_object(obj)
     vertices = vertices @ matrix[:3, :3].T + matrix[:3, 3]
     if np.linalg.det(matrix[:3, :3]) < 0.0:  # a mirroring scale flips the winding back
         faces = faces[:, ::-1].copy()
     fn = face_normals(vertices, faces)
-    name = cache.key("normals", vertices, faces, obj.normals, obj.crease_angle)
+    parts = () if places is None else (places,)
+    name = cache.key("normals", vertices, faces, obj.normals, obj.crease_angle, *parts)
     hit = cache.load(name)
     if hit is not None and hit.get("corner_normals", np.empty(0)).shape == (len(faces), 3, 3):
         cn = hit["corner_normals"]
     else:
+        # Welded mesh files: corners at one place share their normal even where a uv seam
+        # keeps two vertices (the normals see the welded surface, the texture its seams).
+        first = np.zeros(0, np.int64) if places is None else \
+            np.unique(places, return_index=True)[1]
+        at, by = (vertices, faces) if places is None else (vertices[first], places[faces])
         with busy(f"objects.{index}: {len(faces)} triangles' normals"):
-            cn = corner_normals(vertices, faces, obj.normals, obj.crease_angle)
+            cn = corner_normals(at, by, obj.normals, obj.crease_angle,
+                                progress=_triangle_bar(len(faces), f"objects.{index}: normals"))
         cache.store(name, {"corner_normals": cn})
     for array in (vertices, faces, uvs, fn, cn):
         array.setflags(write=False)
@@ -120,12 +131,12 @@ def _cached_mesh(key: tuple, shape: str, index: int):
 
 def _object_from_key(key: tuple) -> Object:
     (shape, path, _base, radius, minor, height, extents, size, vertices, subdivisions, sections,
-     segments, translate, rotate, scale, normals, crease) = key
+     segments, translate, rotate, scale, normals, crease, weld) = key
     return Object(shape=shape, path=path, radius=radius, minor_radius=minor, height=height,
                   extents=extents, size=size, vertices=[list(v) for v in vertices],
                   subdivisions=subdivisions, sections=sections, segments=segments,
                   translate=translate, rotate=rotate, scale=scale, normals=normals,
-                  crease_angle=crease)
+                  crease_angle=crease, weld=weld)
 
 
 def world_from_object(obj: Object) -> np.ndarray:
@@ -156,17 +167,18 @@ def grid(corners: np.ndarray, segments: int) -> tuple[np.ndarray, np.ndarray, np
 
 def _local_mesh(obj: Object, base_dir: str, index: int):
     shape = obj.shape
+    """(vertices, faces, uvs, places): places maps each vertex to its welded position
+    (mesh files loaded with weld; None otherwise)."""
     if shape == "quad":
-        return grid(np.asarray(obj.vertices, dtype=np.float64), obj.segments)
+        return (*grid(np.asarray(obj.vertices, dtype=np.float64), obj.segments), None)
     if shape == "plane":
         h = obj.size / 2.0
         corners = np.array([[-h, 0, h], [h, 0, h], [h, 0, -h], [-h, 0, -h]])
-        return grid(corners, obj.segments)
+        return (*grid(corners, obj.segments), None)
     if shape == "mesh":
-        mesh = load_mesh_file(obj.path, base_dir, f"objects.{index}.path")
-        vertices = np.asarray(mesh.vertices, dtype=np.float64)
-        faces = np.asarray(mesh.faces, dtype=np.int64)
-        return vertices, faces, _projected_uvs(vertices, shape)
+        mesh = read_mesh(obj.path, base_dir, f"objects.{index}.path", weld=obj.weld)
+        uvs = mesh.uvs if mesh.uvs is not None else _projected_uvs(mesh.vertices, shape)
+        return mesh.vertices, mesh.faces, uvs, mesh.places
     name = cache.key("primitive", shape, obj.radius, obj.minor_radius, obj.height,
                      tuple(obj.extents), obj.subdivisions, obj.sections)
     hit = cache.load(name)
@@ -175,7 +187,7 @@ def _local_mesh(obj: Object, base_dir: str, index: int):
     else:
         vertices, faces = _primitive(obj, index)
         cache.store(name, {"vertices": vertices, "faces": faces})
-    return vertices, faces, _projected_uvs(vertices, shape)
+    return vertices, faces, _projected_uvs(vertices, shape), None
 
 
 def _sound(hit: dict | None) -> bool:
@@ -245,7 +257,11 @@ def check_vertices(vertices: np.ndarray, where: str) -> None:
 
 
 def load_mesh_file(path: str, base_dir: str, key: str):
-    """Load a mesh file, refusing what no renderer can use, with a one-line reason."""
+    """Load a mesh file, refusing what no renderer can use, with a one-line reason.
+
+    Returns the trimesh as read (unwelded, degenerate triangles kept); a file whose every
+    triangle is degenerate is refused here (see :func:`read_mesh` for what renderers draw).
+    """
     full = Path(path) if Path(path).is_absolute() else Path(base_dir) / path
     problem = file_problem(full)
     if problem:
@@ -258,9 +274,10 @@ def load_mesh_file(path: str, base_dir: str, key: str):
                  memory_bytes=8.0 * size)  # trimesh's arrays and its text parse
     import trimesh
 
+    options = {"skip_materials": True} if full.suffix.lower() == ".obj" else {}
     try:
         with busy(f"{key}: reading '{full.name}'"):
-            mesh = trimesh.load(str(full), force="mesh", process=False)
+            mesh = trimesh.load(str(full), force="mesh", process=False, **options)
     except Exception as exc:  # trimesh raises many types for corrupt files
         raise ShadeLabError(f"{key}: '{full.name}' could not be read as a mesh ({exc})") from None
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
@@ -269,8 +286,273 @@ def load_mesh_file(path: str, base_dir: str, key: str):
     limits.check(f"{key}: '{full.name}'", len(mesh.faces), limits.MAX_TRIANGLES, "triangles",
                  memory_bytes=400.0 * len(mesh.faces))  # normals, BVH, GL buffers
     areas = face_areas(np.asarray(mesh.vertices, float), np.asarray(mesh.faces))
-    degenerate = np.flatnonzero(areas <= 1e-12 * max(float(areas.max()), 1e-300))
-    if len(degenerate):
-        raise ShadeLabError(f"{key}: '{full.name}' has {len(degenerate)} degenerate (zero-area) "
-                            f"triangles, first at face {degenerate[0]}; repair the mesh")
+    if not (areas > DEGENERATE_AREA * max(float(areas.max()), 1e-300)).any() \
+            or float(areas.max()) == 0.0:
+        raise ShadeLabError(f"{key}: '{full.name}' has only degenerate (zero-area) triangles "
+                            f"({len(areas)} of them): nothing to draw")
     return mesh
+
+
+# ---------------------------------------------------------------- what renderers draw
+
+DEGENERATE_AREA = 1e-12     # a triangle under this fraction of the largest one has no area
+WELD_TOLERANCE = 1e-6       # welding distance, a fraction of the bounding-box diagonal
+UV_TOLERANCE = 1e-6         # texture coordinates closer than this are one
+
+
+@dataclass
+class LoadedMesh:
+    """A mesh file as renderers draw it (object space).
+
+    vertices (V, 3) float64; faces (F, 3) int64 with no zero-area triangle; uvs (V, 2) from
+    the file or None; places (V,) int64, the welded position of each vertex where a uv seam
+    keeps two vertices at one place (None when every vertex is its own place); dropped: the
+    zero-area triangles left out."""
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    uvs: np.ndarray | None
+    places: np.ndarray | None
+    dropped: int = 0
+
+
+def weld_vertices(vertices: np.ndarray, faces: np.ndarray, uvs: np.ndarray | None = None,
+         tolerance: float | None = None):
+    """Merge vertices closer than ``tolerance`` (default WELD_TOLERANCE of the bounding-box
+    diagonal; positions are snapped to a grid of that step) that also share their uv.
+
+    Returns (vertices, faces, uvs, places): places (V,) numbers the distinct positions, so
+    vertices split only by a uv seam share a place (None when no seam splits any).
+    """
+    if tolerance is None:
+        diagonal = float(np.linalg.norm(vertices.max(axis=0) - vertices.min(axis=0)))
+        tolerance = WELD_TOLERANCE * diagonal
+    if tolerance <= 0.0:
+        tolerance = 1e-300
+    snapped = np.round((vertices - vertices.min(axis=0)) / tolerance).astype(np.int64)
+    _, place = np.unique(snapped, axis=0, return_inverse=True)
+    place = place.reshape(-1)
+    if uvs is None:
+        keys = place[:, None]
+    else:
+        keys = np.column_stack([place, np.round(uvs / UV_TOLERANCE).astype(np.int64)])
+    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    new_faces = inverse[faces]
+    new_uvs = None if uvs is None else uvs[first]
+    places = place[first]
+    if len(np.unique(places)) == len(places):
+        places = None
+    else:
+        places = np.unique(places, return_inverse=True)[1].reshape(-1).astype(np.int64)
+    return vertices[first], new_faces.astype(np.int64), new_uvs, places
+
+
+def drop_degenerate(vertices: np.ndarray, faces: np.ndarray,
+                    places: np.ndarray | None = None) -> tuple[np.ndarray, int]:
+    """Faces with no area (two corners at one vertex or place, or area under DEGENERATE_AREA
+    of the largest) left out: (kept faces, how many were dropped)."""
+    corners = faces if places is None else places[faces]
+    areas = face_areas(vertices, faces)
+    keep = ((corners[:, 0] != corners[:, 1]) & (corners[:, 1] != corners[:, 2])
+            & (corners[:, 2] != corners[:, 0])
+            & (areas > DEGENERATE_AREA * max(float(areas.max(initial=0.0)), 1e-300)))
+    return faces[keep], int(len(faces) - keep.sum())
+
+
+_NOTED: set[str] = set()
+
+
+def note(message: str) -> None:
+    """One line on stderr, once per message and process (what was dropped or ignored)."""
+    if message in _NOTED:
+        return
+    _NOTED.add(message)
+    print(f"shadelab: note: {message}", file=sys.stderr, flush=True)
+
+
+def read_mesh(path: str, base_dir: str, key: str, weld: bool = True) -> LoadedMesh:
+    """A mesh file's triangles for the renderers: welded (unless ``weld`` is False), its
+    zero-area triangles dropped with a one-line note; refused only when none is left."""
+    mesh = load_mesh_file(path, base_dir, key)
+    name = Path(path).name
+    vertices = np.asarray(mesh.vertices, dtype=np.float64)
+    faces = np.asarray(mesh.faces, dtype=np.int64)
+    uv = getattr(mesh.visual, "uv", None)
+    uvs = None
+    if uv is not None and len(uv) == len(vertices):
+        uvs = np.asarray(uv, dtype=np.float64)
+        if not np.isfinite(uvs).all():
+            uvs = None
+    places = None
+    if weld:
+        vertices, faces, uvs, places = weld_vertices(vertices, faces, uvs)
+    faces, dropped = drop_degenerate(vertices, faces, places)
+    if len(faces) == 0:
+        raise ShadeLabError(f"{key}: '{name}' has only degenerate (zero-area) triangles "
+                            f"({dropped} of them): nothing to draw")
+    if dropped:
+        note(f"{key}: '{name}': dropped {dropped} degenerate (zero-area) "
+             f"triangle{'s' if dropped != 1 else ''} of {dropped + len(faces)}")
+    return LoadedMesh(vertices, faces, uvs, places, dropped)
+
+
+TRIANGLE_BAR_MIN = 200_000  # a mesh this large shows a bar (in triangles) on a terminal
+
+
+def _triangle_bar(total: int, desc: str):
+    """A callback ``done(triangles)`` that moves a tqdm bar counted in triangles (CLI on a
+    terminal, meshes of TRIANGLE_BAR_MIN triangles or more; see shadelab.progress), else
+    None."""
+    from shadelab import progress
+
+    if not progress.SHOW_STEPS or total < TRIANGLE_BAR_MIN:
+        return None
+    from tqdm import tqdm
+
+    bar = tqdm(total=total, desc=desc, unit="tri", unit_scale=True, leave=False,
+               delay=progress.STEP_DELAY_S, mininterval=0.5, dynamic_ncols=True)
+
+    def done(triangles: int) -> None:
+        bar.update(triangles)
+        if bar.n >= total:
+            bar.close()
+
+    return done
+
+
+# ---------------------------------------------------------------- an OBJ's material (MTL)
+
+MTL_USED = ("newmtl", "Kd", "map_Kd")
+
+
+@dataclass
+class ObjMaterial:
+    """The first material an OBJ file uses, from its MTL: ``kd`` (or None), ``map_kd`` the
+    texture file (resolved beside the MTL, or None), ``ignored`` what ShadeLab does not use."""
+
+    name: str
+    mtl: Path
+    kd: tuple[float, float, float] | None = None
+    map_kd: Path | None = None
+    ignored: list[str] = field(default_factory=list)
+
+
+_OBJ_MTL = re.compile(rb"^[ \t]*(mtllib|usemtl)[ \t]+([^\r\n#]*)", re.MULTILINE)
+
+
+def obj_material(full: Path, key: str) -> ObjMaterial | None:
+    """The material an OBJ file names (``mtllib`` + first ``usemtl``), or None when it names
+    none; an MTL that cannot be read is a one-line note and None, not an error."""
+    try:
+        data = full.read_bytes()
+    except OSError:
+        return None  # load_mesh_file reports the file itself
+    libraries, used = [], []
+    for word, value in _OBJ_MTL.findall(data):
+        text = value.decode("utf-8", "replace").strip()
+        if text:
+            (libraries if word == b"mtllib" else used).append(text)
+    if not libraries:
+        return None
+    mtl = full.parent / libraries[0].replace("\\", "/")
+    problem = file_problem(mtl)
+    if problem:
+        note(f"{key}: '{full.name}' names material library '{libraries[0]}', which {problem}; "
+             f"its colours are ignored")
+        return None
+    try:
+        text = mtl.read_bytes().decode("utf-8", "replace")
+    except OSError as exc:
+        note(f"{key}: '{mtl.name}' could not be read ({exc.strerror}); its colours are ignored")
+        return None
+    tables: dict[str, dict[str, str]] = {}
+    current = None
+    for line in text.splitlines():
+        parts = line.split("#", 1)[0].split(None, 1)
+        if not parts:
+            continue
+        word, rest = parts[0], (parts[1].strip() if len(parts) > 1 else "")
+        if word == "newmtl":
+            current = tables.setdefault(rest, {})
+        elif current is not None:
+            current[word] = rest
+    distinct = list(dict.fromkeys(used))
+    name = distinct[0] if distinct else next(iter(tables), "")
+    if name not in tables:
+        note(f"{key}: '{mtl.name}' has no material '{name}'; its colours are ignored")
+        return None
+    table = tables[name]
+    out = ObjMaterial(name, mtl)
+    if "Kd" in table:
+        try:
+            kd = [float(v) for v in table["Kd"].split()[:3]]
+            if len(kd) == 3 and all(math.isfinite(v) for v in kd):
+                out.kd = tuple(min(max(v, 0.0), 1.0) for v in kd)
+        except ValueError:
+            pass
+        if out.kd is None:
+            out.ignored.append(f"Kd '{table['Kd']}' (expected three numbers)")
+    if table.get("map_Kd"):
+        # options (-s 1 1 1, -clamp on, ...) come first; the file name is the last word
+        out.map_kd = mtl.parent / table["map_Kd"].split()[-1].replace("\\", "/")
+    out.ignored += sorted(k for k in table if k not in MTL_USED)
+    if len(distinct) > 1:
+        out.ignored.append(f"materials {', '.join(distinct[1:])} (one material per object)")
+    return out
+
+
+def adopt_obj_materials(scene: Scene, given: dict[str, set[str]], source: str) -> None:
+    """Each OBJ object's MTL ``Kd`` and ``map_Kd`` as its material's ``Od`` and ``texture``
+    (at ``texture_scale`` 1, the file's own uvs) where the preset sets none of them
+    (``given``: the keys each preset material table sets). The object gets a copy of its
+    material named ``<material>-<file stem>``; what the MTL holds beyond them is named once
+    in one line. A texture file that is not there is a one-line error."""
+    for i, obj in enumerate(scene.objects):
+        if obj.shape != "mesh" or Path(obj.path).suffix.lower() != ".obj":
+            continue
+        key = f"objects.{i}.path"
+        full = Path(obj.path) if Path(obj.path).is_absolute() else Path(scene.base_dir) / obj.path
+        info = obj_material(full, key)
+        if info is None:
+            continue
+        keys = given.get(obj.material, set())
+        changes: dict = {}
+        ignored = list(info.ignored)
+        if info.map_kd is not None:
+            if "texture" in keys:
+                ignored.append("map_Kd (the preset sets a texture)")
+            else:
+                problem = file_problem(info.map_kd)
+                if problem:
+                    raise ShadeLabError(f"{source}: key '{key}': '{info.mtl.name}' names texture "
+                                        f"map_Kd '{info.map_kd.name}', which {problem}")
+                changes["texture"] = _relative(info.map_kd, Path(scene.base_dir))
+                if "texture_scale" not in keys:
+                    changes["texture_scale"] = 1.0
+        if info.kd is not None:
+            if "Od" in keys:
+                ignored.append("Kd (the preset sets Od)")
+            else:
+                changes["Od"] = info.kd
+        if ignored:
+            note(f"{key}: '{info.mtl.name}' material '{info.name}': ignored {', '.join(ignored)}")
+        if not changes:
+            continue
+        material = copy.deepcopy(scene.materials[obj.material])
+        for name, value in changes.items():
+            setattr(material, name, value)
+        base = f"{obj.material}-{full.stem}"
+        name, n = base, 2
+        while name in scene.materials and scene.materials[name] != material:
+            name, n = f"{base}-{n}", n + 1
+        scene.materials[name] = material
+        obj.material = name
+
+
+def _relative(path: Path, base: Path) -> str:
+    """``path`` relative to ``base`` where it can be (POSIX separators), else absolute."""
+    try:
+        return Path(os.path.relpath(path.resolve(), base.resolve())).as_posix()
+    except ValueError:  # another drive
+        return str(path.resolve())

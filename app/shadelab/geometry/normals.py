@@ -73,11 +73,12 @@ def vertex_normals(vertices: np.ndarray, faces: np.ndarray, weighting: str = "an
 
 
 def crease_corner_normals(vertices: np.ndarray, faces: np.ndarray,
-                          crease_angle_deg: float) -> np.ndarray:
+                          crease_angle_deg: float, progress=None) -> np.ndarray:
     """Per-corner normals (F, 3, 3): angle-weighted average over the faces around the vertex
     whose normals lie within ``crease_angle_deg`` of this face's normal.
 
-    A cube (crease 30 degrees) keeps its sharp edges; a sphere stays smooth.
+    A cube (crease 30 degrees) keeps its sharp edges; a sphere stays smooth. ``progress``,
+    when given, is called with a count of triangles (corners / 3) as the work goes on.
     """
     fn = face_normals(vertices, faces)
     weights = corner_angles(vertices, faces)
@@ -91,11 +92,18 @@ def crease_corner_normals(vertices: np.ndarray, faces: np.ndarray,
     corner_face = order // 3
     wn = fn[corner_face] * weights.reshape(-1)[order][:, None]
     out = np.zeros((len(corner_vertex), 3))
-    for s, e in zip(starts, ends, strict=True):
+    step = max(len(starts) // 100, 1)
+    reported = 0
+    for i, (s, e) in enumerate(zip(starts, ends, strict=True)):
         group = order[s:e]
         normals_here = fn[group // 3]                     # (k, 3) face normal of each corner
         close = normals_here @ normals_here.T >= cos_limit  # (k, k) faces within the crease
         out[group] = close.astype(float) @ wn[s:e]
+        if progress is not None and (i + 1) % step == 0:
+            progress(e // 3 - reported)
+            reported = e // 3
+    if progress is not None and len(faces) > reported:
+        progress(len(faces) - reported)
     out = _unit(out).reshape(faces.shape + (3,))
     return _fallback(out, fn)
 
@@ -107,16 +115,21 @@ def _fallback(corner: np.ndarray, fn: np.ndarray) -> np.ndarray:
 
 
 def corner_normals(vertices: np.ndarray, faces: np.ndarray, mode: str,
-                   crease_angle_deg: float = 30.0) -> np.ndarray:
+                   crease_angle_deg: float = 30.0, progress=None) -> np.ndarray:
     """Per-corner normals (F, 3, 3) for a normals mode of
-    :data:`shadelab.scene.model.NORMALS_MODES`."""
+    :data:`shadelab.scene.model.NORMALS_MODES`; ``progress(triangles)`` as in
+    :func:`crease_corner_normals` (the other modes are one vectorized step)."""
     fn = face_normals(vertices, faces)
     if mode == "flat":
-        return np.repeat(fn[:, None, :], 3, axis=1)
-    if mode == "crease":
-        return crease_corner_normals(vertices, faces, crease_angle_deg)
-    vn = vertex_normals(vertices, faces, mode)
-    return _fallback(vn[faces], fn)
+        out = np.repeat(fn[:, None, :], 3, axis=1)
+    elif mode == "crease":
+        return crease_corner_normals(vertices, faces, crease_angle_deg, progress)
+    else:
+        vn = vertex_normals(vertices, faces, mode)
+        out = _fallback(vn[faces], fn)
+    if progress is not None:
+        progress(len(faces))
+    return out
 
 
 def terminator_threshold(fn: np.ndarray, cn: np.ndarray) -> float:

@@ -181,6 +181,8 @@ class Object(Checked):
     normals: str = spec("crease", "str", NORMALS_MODES, doc="vertex normal rule")
     crease_angle: float = spec(30.0, "float", 0.0, 180.0, doc="crease mode: split above, degrees")
     cast_shadows: bool = spec(True, "bool", doc="casts shadow volumes / blocks shadow rays")
+    weld: bool = spec(True, "bool", doc="mesh files: merge corners that share a position "
+                      "(1e-6 of the bounding-box diagonal) so normals can be smooth")
 
 
 @dataclass

@@ -82,6 +82,11 @@ def load_preset(name_or_path: str, overrides: list[str] | None = None) -> Scene:
     scene.name = path.stem
     scene.base_dir = str(path.resolve().parent)
     check_files(scene, str(path))
+    from shadelab.geometry.mesh import adopt_obj_materials  # an OBJ's MTL: Kd, map_Kd
+
+    tables = raw.get("materials") if isinstance(raw.get("materials"), dict) else {}
+    adopt_obj_materials(scene, {name: set(t) for name, t in tables.items()
+                                if isinstance(t, dict)}, str(path))
     return scene
 
 
