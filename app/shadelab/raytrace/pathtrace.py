@@ -327,7 +327,7 @@ class PathTracer:
         rows = len(self.rho)
         mat = mat.copy()
         mat[idx] = rows + np.arange(len(idx))
-        rho = np.concatenate([self.rho, self.kd[base, None] * od])
+        rho = np.concatenate([self.rho, packing.textured_reflectance(self.kd[base], od)])
         return (mat, (rho, *(np.concatenate([t, t[base]]) for t in tables[1:])),
                 tuple(np.concatenate([t, t[base]]) for t in lobes))
 

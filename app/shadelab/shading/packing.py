@@ -39,6 +39,11 @@ def reflectance(material: Material) -> np.ndarray:
     return material.kd * np.asarray(material.Od, dtype=np.float64)
 
 
+def textured_reflectance(kd: np.ndarray, od: np.ndarray) -> np.ndarray:
+    """(N, 3) rho = kd Od at N points of textured surfaces: kd (N,) and the texture's Od (N, 3)."""
+    return kd[:, None] * od
+
+
 @dataclass(frozen=True)
 class PackedMaterial:
     """One material's coefficients as the renderers read them (float64)."""
