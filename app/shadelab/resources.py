@@ -8,10 +8,12 @@ _PACKAGE_DIR = Path(__file__).resolve().parent
 
 
 def resource_dir(name: str) -> Path:
-    """Return the folder ``name`` ("shaders" or "presets").
+    """Return the folder ``name`` ("shaders" or "presets"): the one way every module finds
+    them (``gl/programs.py``, ``testing.py``, ``scene/preset.py``).
 
-    A wheel ships them inside the package (``shadelab/shaders``); a checkout keeps them at the
-    repository root, beside ``app/`` (the package itself is ``app/shadelab``).
+    A wheel ships them inside the package (``shadelab/shaders``, pyproject's force-include); a
+    checkout keeps them at the repository root, beside ``app/`` (the package itself is
+    ``app/shadelab``). tests/shading/test_shader_dir.py checks both layouts.
     """
     for candidate in (_PACKAGE_DIR / name, _PACKAGE_DIR.parent.parent / name):
         if candidate.is_dir():

@@ -6,16 +6,19 @@ from __future__ import annotations
 
 import math
 
+import numba as nb
 import numpy as np
 import pytest
 
-from shadelab.raytrace import glossy, kernels
+from shadelab.raytrace import glossy, vertex
 from shadelab.raytrace.pathtrace import (
     PathTracer,
     glossy_directions,
     glossy_lobe_pdf,
     render_pathtraced,
 )
+from shadelab.raytrace.scatter import _sample_cosine_hemisphere
+from shadelab.raytrace.vertex import _emission_weight, _specular_lobe
 from shadelab.scene.model import Camera, Material, Object, Scene
 from shadelab.scene.preset import load_preset
 
@@ -218,21 +221,119 @@ def test_numba_and_numpy_path_tracers_agree_with_glossy_inter_reflection(specula
 
 # ---------------------------------------------------------------- ks = 0: nothing changes
 
-def test_ks_zero_scenes_are_the_diffuse_only_kernels_images(monkeypatch):
-    """cornell and cornell-spheres (ks = 0 everywhere): glossy.path_vertex renders bit for bit
-    what kernels.path_vertex (no glossy lobe) does; a glossy material changes the image."""
+# The diffuse-only vertex the path tracer had before the glossy lobe (the oracle: the shared
+# vertex.path_vertex and vertex._next_event must give these numbers bit for bit when ks = 0).
+@nb.njit
+def _diffuse_next_event(i, m, emitters, rho, beta, px, py, pz, nx, ny, nz, gx, gy, gz, prob_d,
+                        eps, rnd, nee_o, nee_d, nee_t, nee_ok, nee_val):
+    em_cdf, em_p0, em_e1, em_e2, em_normal, em_le, em_area = emitters
+    k = np.searchsorted(em_cdf, rnd[i, 0], side="right")
+    k = min(k, len(em_cdf) - 1)
+    s = math.sqrt(rnd[i, 1])
+    a, b = s * (1.0 - rnd[i, 2]), s * rnd[i, 2]
+    qx = em_p0[k, 0] + a * em_e1[k, 0] + b * em_e2[k, 0] - px
+    qy = em_p0[k, 1] + a * em_e1[k, 1] + b * em_e2[k, 1] - py
+    qz = em_p0[k, 2] + a * em_e1[k, 2] + b * em_e2[k, 2] - pz
+    dist = math.sqrt(qx * qx + qy * qy + qz * qz)
+    if not dist > 2.0 * eps:
+        return
+    wx, wy, wz = qx / dist, qy / dist, qz / dist
+    cos_x = nx * wx + ny * wy + nz * wz
+    cos_y = abs(em_normal[k, 0] * wx + em_normal[k, 1] * wy + em_normal[k, 2] * wz)
+    if not (cos_x > 0.0 and gx * wx + gy * wy + gz * wz > 0.0):
+        return
+    light_pdf = dist * dist / max(cos_y * em_area, 1e-300)
+    scale = cos_x / (light_pdf + prob_d * cos_x / math.pi) / math.pi
+    nee_ok[i] = True
+    nee_o[i, 0] = px + eps * gx
+    nee_o[i, 1] = py + eps * gy
+    nee_o[i, 2] = pz + eps * gz
+    nee_d[i, 0], nee_d[i, 1], nee_d[i, 2] = wx, wy, wz
+    nee_t[i] = dist * (1.0 - 1e-4) - 2.0 * eps
+    for c in range(3):
+        nee_val[i, c] = beta[i, c] * rho[m, c] * em_le[k, c] * scale
+
+
+@nb.njit
+def _diffuse_path_vertex(out, pixel, beta, bsdf_pdf, position, normal, geo, entering, dirs, t,
+                         mat, surfaces, emitters, eps, rnd, roulette):
+    rho, kr, kt, ior, emission = surfaces
+    em_area = emitters[6]
+    n = len(pixel)
+    nee_o = np.empty((n, 3))
+    nee_d = np.empty((n, 3))
+    nee_t = np.empty(n)
+    nee_ok = np.zeros(n, np.bool_)
+    nee_val = np.zeros((n, 3))
+    new_o = np.empty((n, 3))
+    new_d = np.empty((n, 3))
+    new_beta = np.empty((n, 3))
+    new_pdf = np.zeros(n)
+    alive = np.zeros(n, np.bool_)
+    n_em = len(emitters[0])
+    for i in range(n):
+        m = mat[i]
+        px, py, pz = position[i, 0], position[i, 1], position[i, 2]
+        nx, ny, nz = normal[i, 0], normal[i, 1], normal[i, 2]
+        gx, gy, gz = geo[i, 0], geo[i, 1], geo[i, 2]
+        dx, dy, dz = dirs[i, 0], dirs[i, 1], dirs[i, 2]
+        if max(emission[m, 0], max(emission[m, 1], emission[m, 2])) > 0.0:
+            w = _emission_weight(bsdf_pdf[i], t[i], abs(gx * dx + gy * dy + gz * dz), em_area)
+            for c in range(3):
+                out[pixel[i], c] += beta[i, c] * emission[m, c] * w
+        p_d = (rho[m, 0] + rho[m, 1] + rho[m, 2]) / 3.0
+        total = p_d + kr[m] + kt[m]
+        prob_d = p_d / total if total > 0.0 else 0.0
+        if n_em > 0 and p_d > 0.0:
+            _diffuse_next_event(i, m, emitters, rho, beta, px, py, pz, nx, ny, nz, gx, gy, gz,
+                                prob_d, eps, rnd, nee_o, nee_d, nee_t, nee_ok, nee_val)
+        if total <= 0.0:
+            continue
+        u = rnd[i, 3] * total
+        side = 1.0
+        if u < p_d:
+            ox, oy, oz, cos_o = _sample_cosine_hemisphere(rnd[i, 4], rnd[i, 5], nx, ny, nz)
+            if ox * gx + oy * gy + oz * gz <= 0.0:
+                continue
+            for c in range(3):
+                new_beta[i, c] = beta[i, c] * rho[m, c] / prob_d
+            new_pdf[i] = prob_d * cos_o / math.pi
+        else:
+            ox, oy, oz, side, weight, prob = _specular_lobe(u, p_d, kr[m], kt[m], ior[m],
+                                                            entering[i], total, dx, dy, dz,
+                                                            nx, ny, nz, rnd[i, 4])
+            for c in range(3):
+                new_beta[i, c] = beta[i, c] * weight / prob
+        if roulette:
+            q = min(max(new_beta[i, 0], max(new_beta[i, 1], new_beta[i, 2])), 0.95)
+            if rnd[i, 6] >= q:
+                continue
+            for c in range(3):
+                new_beta[i, c] /= max(q, 1e-12)
+        alive[i] = True
+        new_d[i, 0], new_d[i, 1], new_d[i, 2] = ox, oy, oz
+        new_o[i, 0] = px + side * eps * gx
+        new_o[i, 1] = py + side * eps * gy
+        new_o[i, 2] = pz + side * eps * gz
+    return nee_o, nee_d, nee_t, nee_ok, nee_val, new_o, new_d, new_beta, new_pdf, alive
+
+
+def test_ks_zero_scenes_are_the_diffuse_only_vertex_images(monkeypatch):
+    """cornell and cornell-spheres (ks = 0 everywhere): vertex.path_vertex (with the one
+    shared _next_event) renders bit for bit what the diffuse-only vertex above (the path
+    tracer's before the glossy lobe) does; a glossy material changes the image."""
     scenes = [load_preset("cornell"), load_preset("cornell-spheres")]
     images = [render_pathtraced(s, (16, 12), 2, seed=9) for s in scenes]
 
     def diffuse_only(out, pixel, beta, bsdf_pdf, position, normal, geo, entering, dirs, t,
                      mat, surfaces, lobes, emitters, eps, rnd, roulette, blinn):
         assert not lobes[2].any()
-        return kernels.path_vertex(out, pixel, beta, bsdf_pdf, position, normal, geo,
-                                   entering, dirs, t, mat, surfaces, emitters, eps, rnd,
-                                   roulette)
+        return _diffuse_path_vertex(out, pixel, beta, bsdf_pdf, position, normal, geo,
+                                    entering, dirs, t, mat, surfaces, emitters, eps, rnd,
+                                    roulette)
 
     with monkeypatch.context() as patch:
-        patch.setattr(glossy, "path_vertex", diffuse_only)
+        patch.setattr(vertex, "path_vertex", diffuse_only)
         for scene, image in zip(scenes, images, strict=True):
             np.testing.assert_array_equal(render_pathtraced(scene, (16, 12), 2, seed=9),
                                           image)

@@ -6,12 +6,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from shadelab.raytrace import kernels
 from shadelab.raytrace.surface import TraceContext
 from shadelab.raytrace.whitted import render_raytraced, trace_batch
 from shadelab.scene.camera import primary_rays
 from shadelab.scene.model import Light, Material
 from shadelab.scene.preset import load_preset
+from shadelab.shading import kernels as shading_kernels
+from shadelab.shading import packing
 from shadelab.shading.reference import normalize, shade
 
 
@@ -42,8 +43,10 @@ def test_local_shade_matches_reference_shade(np_rng, specular):
     mat = np_rng.integers(0, len(materials), n)
     shadow = np_rng.random((len(lights), n))
     ia = np.array([0.1, 0.2, 0.3])
-    got = kernels.local_shade(position, normal, to_eye, mat, kernels.material_table(materials),
-                              kernels.light_table(lights), ia, specular == "blinn", shadow)
+    got = shading_kernels.local_shade(position, normal, to_eye, mat,
+                                      packing.material_table(materials),
+                                      packing.light_table(lights), ia, specular == "blinn",
+                                      shadow)
     for m, material in enumerate(materials):
         idx = np.flatnonzero(mat == m)
         expected = shade(position[idx], normal[idx], position[idx] + to_eye[idx], material,
@@ -84,8 +87,9 @@ def test_kernels_called_first_in_a_fresh_process_run_from_numbas_cache():
 
     script = (
         "import numpy as np\n"
-        "from shadelab.raytrace import kernels as K\n"
-        "o, d = K.camera_rays(np.zeros(3), np.array([0, 0, 1.0]), np.array([1.0, 0, 0]),"
+        "from shadelab.raytrace import rays as R\n"
+        "from shadelab.shading import kernels as K\n"
+        "o, d = R.camera_rays(np.zeros(3), np.array([0, 0, 1.0]), np.array([1.0, 0, 0]),"
         " np.array([0, 1.0, 0]), 0.5, 8, 6, 0, 6, np.zeros((0, 0, 2)))\n"
         "assert o.shape == (48, 3) and abs(np.linalg.norm(d, axis=1) - 1).max() < 1e-12\n"
         "s = K.local_shade(np.ones((4, 3)), np.tile([0, 1.0, 0], (4, 1)),"

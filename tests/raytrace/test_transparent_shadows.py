@@ -114,7 +114,7 @@ def test_ray_tree_reports_the_filtered_shadow():
 def test_one_pass_per_channel_kernel_equals_a_pass_per_channel():
     """kernels.local_shade_into3 (S_i per channel in one pass) == three local_shade_into
     passes with each channel's S_i, bit for bit, on random points, materials and S."""
-    from shadelab.raytrace import kernels
+    from shadelab.shading import kernels
 
     scene = load_preset("shadows-colored")
     ctx = TraceContext(scene)

@@ -22,6 +22,7 @@ import numpy as np
 from shadelab.errors import ShadeLabError
 from shadelab.geometry.mesh import scene_meshes
 from shadelab.scene.model import Scene
+from shadelab.shading.packing import reflectance
 
 MAX_LEVEL = 6  # quadtree depth below the base grid
 FINE = 1 << MAX_LEVEL  # integer units per base cell edge
@@ -232,7 +233,7 @@ def assemble(scene: Scene, surfaces: list[Surface], leaves: list[tuple]) -> Patc
     for index, s in enumerate(surfaces):
         material = scene.materials[s.material]
         mask = surface_of == index
-        rho[mask] = material.kd * np.asarray(material.Od, float)
+        rho[mask] = reflectance(material)
         emission[mask] = material.emission
     keep = areas > 1e-12 * max(float(areas.max(initial=0.0)), 1e-300)
     centers = (polygons * _corner_weights(polygons)[..., None]).sum(axis=1)

@@ -33,6 +33,7 @@ from shadelab.radiosity.solvers import (
 )
 from shadelab.scene.camera import primary_rays
 from shadelab.scene.model import Scene
+from shadelab.shading.packing import reflectance
 
 REFINE_SHARE = 0.85  # adaptive meshing starts from this share of the target count (Cornell,
 #                     64x64 against the path tracer: 0.5 -> 5.3 % at 400 patches, 0.85 -> 4.6 %;
@@ -106,7 +107,7 @@ def precheck(scene: Scene, count: int, method: str = "raycast") -> None:
     is closed enough that (I - rho F) B = E has no bounded solution."""
     check_scene(scene)
     used = {obj.material for obj in scene.objects}
-    if all(max(scene.materials[m].kd * np.asarray(scene.materials[m].Od)) < 1.0 for m in used):
+    if all(max(reflectance(scene.materials[m])) < 1.0 for m in used):
         return  # row sums of rho F < 1: every solver converges
     patches = uniform_patches(scene, min(check_count(count), 200))
     F = FormFactors(patches, "raycast" if method == "hemicube" else method).matrix()
@@ -115,8 +116,7 @@ def precheck(scene: Scene, count: int, method: str = "raycast") -> None:
 
 def _rho_names(scene: Scene, patches: PatchSet) -> str:
     names = sorted({s.material for s in patches.surfaces
-                    if max(scene.materials[s.material].kd * np.asarray(
-                        scene.materials[s.material].Od)) >= 1.0})
+                    if max(reflectance(scene.materials[s.material])) >= 1.0})
     return ", ".join(f"materials.{n}" for n in names) or "materials"
 
 

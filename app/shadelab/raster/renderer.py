@@ -28,8 +28,16 @@ from shadelab.raster.textures import TextureCache, has_surface_detail
 from shadelab.raster.transparency import draw_transparent
 from shadelab.scene.camera import clip_from_world, far_plane, gl_matrix
 from shadelab.scene.model import MAX_LIGHTS, Light, Material, Scene
-from shadelab.shading.codes import ATTENUATION_CODES, LIGHT_KIND_CODES, SPECULAR_CODES
-from shadelab.shading.lights import pack_lights
+from shadelab.shading.codes import ATTENUATION_CODES, CODE_BITS, SPECULAR_CODES
+from shadelab.shading.lights import light_kind
+from shadelab.shading.packing import (
+    PackedMaterial,
+    light_uniform_arrays,
+    material_key,
+    material_uniforms,
+    pack_material,
+    premultiplied_uniforms,
+)
 
 SHADING_PROGRAMS = ("flat", "gouraud", "phong")
 # Variants with texture-mapped Od and bump maps (a geometry shader adds the tangents); only
@@ -38,7 +46,6 @@ TEXTURED_PROGRAMS = {name: f"{name}_tex" for name in SHADING_PROGRAMS}
 # The programs whose Od is the material's u_Od: compiled with PREMULTIPLIED (lighting.glsl), so
 # the per-material, per-light factors are folded here once instead of read per fragment.
 PREMULTIPLIED = {"PREMULTIPLIED": 1}
-MATERIAL_FLOATS = ("u_ka", "u_kd", "u_ks", "u_n")
 
 
 @dataclass
@@ -119,16 +126,17 @@ class Renderer:
     @staticmethod
     def light_signature_of(lights: list[Light], specular: str) -> tuple:
         """What a program variant is compiled for: each light's (kind, attenuation) codes."""
-        codes = tuple((LIGHT_KIND_CODES[light.kind], ATTENUATION_CODES[light.attenuation])
+        codes = tuple((light_kind(light).code, ATTENUATION_CODES[light.attenuation])
                       for light in lights[:MAX_LIGHTS])
         return codes, specular
 
     @staticmethod
     def light_defines(signature: tuple) -> dict[str, object]:
-        """The ``#define``s of ``lighting.glsl`` for a light signature (2 bits per light)."""
+        """The ``#define``s of ``lighting.glsl`` for a light signature (CODE_BITS = 2 bits per
+        light)."""
         codes, model = signature
-        kinds = sum(kind << (2 * i) for i, (kind, _) in enumerate(codes))
-        attenuations = sum(att << (2 * i) for i, (_, att) in enumerate(codes))
+        kinds = sum(kind << (CODE_BITS * i) for i, (kind, _) in enumerate(codes))
+        attenuations = sum(att << (CODE_BITS * i) for i, (_, att) in enumerate(codes))
         return {"NUM_LIGHTS": len(codes), "LIGHT_KINDS": f"{kinds}u",
                 "LIGHT_ATTENUATIONS": f"{attenuations}u",
                 "SPECULAR_MODEL": SPECULAR_CODES[model]}
@@ -302,23 +310,21 @@ class Renderer:
         program reads them, the folded u_ambient, u_light_diffuse, u_light_specular where it is
         PREMULTIPLIED (computed once per material and frame state)."""
         state = self.uniforms(program)
-        values = (material.ka, material.kd, material.ks, material.n, *material.Od,
-                  *material.Os, *material.emission)
+        values = material_key(material)
         writes = state.materials.get(values)
         if writes is None:
             if len(state.materials) > 256:  # a slider sweeping a coefficient
                 state.materials.clear()
-            writes = state.materials[values] = _material_writes(state, values)
+            writes = state.materials[values] = _material_writes(state, pack_material(material))
         for name, data in writes:
             state.cache.write(name, data)
 
     @staticmethod
     def set_material_uniforms(program: moderngl.Program, material: Material) -> None:
-        for name in ("ka", "kd", "ks", "n"):
-            set_uniform(program, f"u_{name}", float(getattr(material, name)))
-        set_uniform(program, "u_Od", tuple(material.Od))
-        set_uniform(program, "u_Os", tuple(material.Os))
-        set_uniform(program, "u_emission", tuple(material.emission))
+        """The raw material uniforms (no cache, no folding): the same bytes
+        :meth:`write_material` writes, from :func:`shadelab.shading.packing.material_uniforms`."""
+        for name, data in material_uniforms(pack_material(material)).items():
+            set_uniform(program, name, data)
 
     # ------------------------------------------------------------ passes
     def render(self, scene: Scene, target: RenderTarget, shading: str | None = None,
@@ -561,28 +567,6 @@ def is_transparent(material: Material) -> bool:
     return material.kt > 0.0
 
 
-def light_uniform_arrays(lights: list[Light],
-                         shadow: list[float] | None = None) -> dict[str, np.ndarray]:
-    """The ``u_light_*`` arrays of ``lighting.glsl`` (padded to MAX_LIGHTS) from
-    :func:`shadelab.shading.lights.pack_lights`, the packing the ray tracer's table uses, and
-    ``u_num_lights`` (int32, one element)."""
-    count = min(len(lights), MAX_LIGHTS)
-    packed = pack_lights(lights[:count])
-    s = np.ones(MAX_LIGHTS, np.float32)
-    if shadow is not None:
-        s[:count] = shadow[:count]
-    arrays = {"u_num_lights": np.array([count], np.int32)}
-    for name, array in (("u_light_kind", packed.kind), ("u_light_attenuation", packed.attenuation),
-                        ("u_light_position", packed.position),
-                        ("u_light_direction", packed.direction), ("u_light_Ip", packed.Ip),
-                        ("u_light_c", packed.c), ("u_light_spot", packed.spot)):
-        padded = np.zeros((MAX_LIGHTS, *array.shape[1:]), array.dtype)
-        padded[:count] = array
-        arrays[name] = padded.astype(np.int32 if array.dtype.kind == "i" else np.float32)
-    arrays["u_light_S"] = s
-    return arrays
-
-
 def write_light_uniforms(program: moderngl.Program, lights: list[Light],
                          shadow: list[float] | None = None) -> None:
     """Fill the ``u_light_*`` arrays of ``lighting.glsl`` (see :func:`light_uniform_arrays`)."""
@@ -590,26 +574,19 @@ def write_light_uniforms(program: moderngl.Program, lights: list[Light],
         set_uniform_array(program, name, array)
 
 
-def _material_writes(state: ProgramUniforms, values: tuple) -> list[tuple[str, bytes]]:
+def _material_writes(state: ProgramUniforms, packed: PackedMaterial) -> list[tuple[str, bytes]]:
     """(name, bytes) of a material's uniforms the program reads: ka, kd, ks, n, Od, Os, Le
-    as they are, and for a PREMULTIPLIED program the factors lighting.glsl folds:
-    u_ambient = on (Le + Ia ka Od), u_light_diffuse[i] = S_i Ip,i kd Od,
-    u_light_specular[i] = S_i Ip,i ks Os."""
-    ka, kd, ks, n = values[:4]
-    od, os_, emission = (np.asarray(values[k:k + 3], dtype=np.float64) for k in (4, 7, 10))
-    raw = {**dict(zip(MATERIAL_FLOATS, (struct.pack("f", v) for v in (ka, kd, ks, n)),
-                      strict=True)),
-           "u_Od": od.astype(np.float32).tobytes(), "u_Os": os_.astype(np.float32).tobytes(),
-           "u_emission": emission.astype(np.float32).tobytes()}
+    as they are, and for a PREMULTIPLIED program the factors lighting.glsl folds
+    (:func:`shadelab.shading.packing.premultiplied_uniforms`)."""
     cache = state.cache
-    writes = [(name, data) for name, data in raw.items() if name in cache]
+    writes = [(name, data) for name, data in material_uniforms(packed).items() if name in cache]
     if state.premultiplied:
-        ambient = state.ambient_on * (emission + state.Ia * ka * od)
+        folded = premultiplied_uniforms(packed, state.Ia, state.ip_s, state.ambient_on)
         if "u_ambient" in cache:
-            writes.append(("u_ambient", ambient.astype(np.float32).tobytes()))
-        for name, factor in (("u_light_diffuse", kd * od), ("u_light_specular", ks * os_)):
+            writes.append(("u_ambient", folded["u_ambient"].tobytes()))
+        for name in ("u_light_diffuse", "u_light_specular"):
             uniform = cache.program.get(name, None)
             if uniform is not None:
-                array = (state.ip_s * factor).astype(np.float32)
+                array = folded[name]
                 writes.append((name, array[:max(uniform.array_length, 1)].tobytes()))
     return writes

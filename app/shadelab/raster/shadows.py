@@ -21,7 +21,6 @@ from shadelab.geometry.mesh import scene_bounds
 from shadelab.geometry.silhouette import (
     ShadowVolume,
     closed_caster,
-    light_homogeneous,
     open_caster_groups,
     open_volume,
     shadow_volume,
@@ -30,6 +29,7 @@ from shadelab.geometry.silhouette import (
 from shadelab.gl.programs import load_program, set_uniform
 from shadelab.scene.camera import gl_matrix
 from shadelab.scene.model import Light, Scene
+from shadelab.shading.lights import light_kind
 
 OFFSET_FRACTION = 1e-3  # open casters' volumes start this share of the scene's diagonal away
 VOLUME_COLOR = (0.25, 0.45, 1.0, 0.18)  # translucent volumes (linear RGB, alpha)
@@ -107,7 +107,7 @@ class ShadowVolumes:
         volumes without the sides that cancel: the same count, far less fill)."""
         offset = OFFSET_FRACTION * float(np.linalg.norm(np.ptp(
             scene_bounds([g.mesh for g in gpu_meshes]), axis=0)))
-        homogeneous = light_homogeneous(light.kind, light.position, light.direction)
+        homogeneous = light_kind(light).homogeneous()
         out = []
         live = set()
         grouped = []

@@ -53,11 +53,14 @@ from shadelab.constants import SHADING_EPS as EPS
 from shadelab.constants import T_INF
 from shadelab.errors import ShadeLabError
 from shadelab.progress import Progress
-from shadelab.raytrace import glossy, kernels
+from shadelab.raytrace import glossy, surface_rays, vertex
+from shadelab.raytrace import rays as ray_kernels
 from shadelab.raytrace.accel import Hits, embree_available
 from shadelab.raytrace.surface import TraceContext, reflect_refract
 from shadelab.raytrace.whitted import stratified_jitter
 from shadelab.scene.model import Scene
+from shadelab.shading import kernels as shading_kernels
+from shadelab.shading import packing
 
 TILE_PATHS = 16384    # paths per work unit (one chunk of the generator)
 MAX_BOUNCES = 64      # hard cap; Russian roulette ends paths long before
@@ -176,7 +179,7 @@ class PathTracer:
         self.ctx = TraceContext(scene, backend, local=local) if ctx is None else ctx
         mats = self.ctx.materials
         self.kd = np.array([m.kd for m in mats], float)
-        self.rho = np.array([np.multiply(m.kd, m.Od) for m in mats], float).reshape(-1, 3)
+        self.rho = np.array([packing.reflectance(m) for m in mats], float).reshape(-1, 3)
         self.kr = np.array([m.mirror for m in mats], float)
         self.kt = np.array([m.kt for m in mats], float)
         self.ior = np.array([m.ior for m in mats], float)
@@ -190,9 +193,9 @@ class PathTracer:
         # The lecture's delta lights (all but stand-ins), with a material table without the
         # ambient and emission terms: those are counted by the paths themselves.
         self.delta_lights = [light for light in self.ctx.lights if not light.stand_in]
-        self.delta_table = kernels.light_table(self.delta_lights)
+        self.delta_table = packing.light_table(self.delta_lights)
         self.direct_materials = self.ctx.material_table.copy()
-        self.direct_materials[:, kernels.M_LE:kernels.M_LE + 3] = 0.0
+        self.direct_materials[:, packing.M_LE:packing.M_LE + 3] = 0.0
         self.rays = 0  # counter of rays cast (paths and shadow rays)
         self.primary_hits = 0  # counter of camera rays that hit something
 
@@ -239,7 +242,7 @@ class PathTracer:
     def _radiance_kernel(self, origins: np.ndarray, dirs: np.ndarray,
                          rng: np.random.Generator) -> np.ndarray:
         """:meth:`radiance` with each path vertex in one numba call (same estimator,
-        :func:`shadelab.raytrace.glossy.path_vertex`)."""
+        :func:`shadelab.raytrace.vertex.path_vertex`)."""
         ctx, n, em = self.ctx, len(origins), self.emitters
         out = np.zeros((n, 3))
         beta = np.ones((n, 3))
@@ -252,11 +255,11 @@ class PathTracer:
             o, d, beta, pixel, bsdf_pdf, t, surf, mat, textured = self._hit_vertex(
                 out, o, d, beta, pixel, bsdf_pdf, bounce)
             if self.delta_lights:
-                kernels.add_rows(out, pixel, beta * self._delta_lights(surf, d, mat, textured),
+                ray_kernels.add_rows(out, pixel, beta * self._delta_lights(surf, d, mat, textured),
                                  np.ones(len(pixel), np.bool_))
             mat, tables, lobes = self._textured_tables(mat, textured)
             (nee_o, nee_d, nee_t, nee_ok, nee_val, o, d, beta, bsdf_pdf,
-             alive) = glossy.path_vertex(
+             alive) = vertex.path_vertex(
                 out, pixel, beta, bsdf_pdf, surf.position, surf.normal, surf.geo_normal,
                 surf.entering, np.ascontiguousarray(d), t, mat, tables, lobes,
                 (em.cdf, em.p0, em.e1, em.e2, em.normal, em.le, float(em.total_area)),
@@ -266,7 +269,7 @@ class PathTracer:
                 blocked = ctx.accel.occluded(nee_o[cand], nee_d[cand], nee_t[cand],
                                              everything=True)
                 self.rays += len(cand)
-                kernels.add_rows(out, pixel[cand], nee_val[cand], ~blocked)
+                ray_kernels.add_rows(out, pixel[cand], nee_val[cand], ~blocked)
             o, d, beta, pixel, bsdf_pdf = (o[alive], d[alive], beta[alive], pixel[alive],
                                            bsdf_pdf[alive])
         return out
@@ -280,7 +283,7 @@ class PathTracer:
         if bounce == 0:
             self.primary_hits += int(hits.hit.sum())
         if ctx.kernels:
-            kernels.add_rows(out, pixel, beta * ctx.background, ~hits.hit)
+            ray_kernels.add_rows(out, pixel, beta * ctx.background, ~hits.hit)
         else:
             miss = ~hits.hit
             _add(out, pixel[miss], beta[miss] * ctx.background)
@@ -324,7 +327,7 @@ class PathTracer:
         rows = len(self.rho)
         mat = mat.copy()
         mat[idx] = rows + np.arange(len(idx))
-        rho = np.concatenate([self.rho, self.kd[base, None] * od])
+        rho = np.concatenate([self.rho, packing.textured_reflectance(self.kd[base], od)])
         return (mat, (rho, *(np.concatenate([t, t[base]]) for t in tables[1:])),
                 tuple(np.concatenate([t, t[base]]) for t in lobes))
 
@@ -340,22 +343,22 @@ class PathTracer:
         ng = np.ascontiguousarray(surf.geo_normal)
         shadow = np.zeros((len(self.delta_lights), n))
         for k in range(len(self.delta_lights)):
-            origin, dirs, tmax, facing = kernels.shadow_rays(pos, ng, self.delta_table, k,
+            origin, dirs, tmax, facing = surface_rays.shadow_rays(pos, ng, self.delta_table, k,
                                                              ctx.eps, T_INF)
             idx = np.flatnonzero(facing)
             if len(idx):
                 blocked = ctx.accel.occluded(origin[idx], dirs[idx], tmax[idx])
                 shadow[k, idx] = np.where(blocked, 0.0, 1.0)
                 self.rays += len(idx)
-        out = kernels.local_shade(pos, np.ascontiguousarray(surf.normal),
+        out = shading_kernels.local_shade(pos, np.ascontiguousarray(surf.normal),
                                   np.ascontiguousarray(-d), mat, self.direct_materials,
                                   self.delta_table, np.zeros(3), ctx.specular == "blinn",
                                   shadow)
         if textured is not None:  # the same terms with Od(u, v) (no ambient, no emission)
             idx, od = textured
             table = self.direct_materials[mat[idx]]  # a copy (fancy index)
-            table[:, kernels.M_OD:kernels.M_OD + 3] = od
-            out[idx] = kernels.local_shade(pos[idx], np.ascontiguousarray(surf.normal[idx]),
+            table[:, packing.M_OD:packing.M_OD + 3] = od
+            out[idx] = shading_kernels.local_shade(pos[idx], np.ascontiguousarray(surf.normal[idx]),
                                            np.ascontiguousarray(-d[idx]),
                                            np.arange(len(idx)), np.ascontiguousarray(table),
                                            self.delta_table, np.zeros(3),
@@ -556,7 +559,7 @@ class TileJob:
         jitter = (rng.random((r1 - r0, width, 2)) if self.spp == 1
                   else stratified_jitter(self.spp, sample, (r1 - r0, width), rng))
         forward, right, up = self.frame
-        o, d = kernels.camera_rays(self.eye, forward, right, up, self.tan_half, width, height,
+        o, d = ray_kernels.camera_rays(self.eye, forward, right, up, self.tan_half, width, height,
                                    r0, r1, jitter)
         before_rays, before_hits = self.tracer.rays, self.tracer.primary_hits
         radiance = self.tracer.radiance(o, d, rng)

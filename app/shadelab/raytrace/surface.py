@@ -11,10 +11,13 @@ from functools import cached_property
 
 import numpy as np
 
-from shadelab.raytrace import kernels
+from shadelab.raytrace import rays as ray_kernels
+from shadelab.raytrace import surface_rays
 from shadelab.raytrace.accel import T_INF, Hits, SceneGeometry, build_accel, scene_geometry
 from shadelab.raytrace.detail import SceneDetail
 from shadelab.scene.model import Material, Scene
+from shadelab.shading import kernels as shading_kernels
+from shadelab.shading import packing
 from shadelab.shading.reference import light_vectors, shade
 
 MAX_SHADOW_CROSSINGS = 16  # transparent surfaces a shadow ray is followed through
@@ -90,7 +93,7 @@ class TraceContext:
     backend : "auto" (Embree where embreex imports), "embree" or "bvh"
     shadows : False makes every S_i = 1 (no shadow rays), as the raster without volumes
     offset : ray origin offset as a fraction of the scene diagonal (default: the preset's)
-    local : "numba" (the kernels of :mod:`shadelab.raytrace.kernels`, fast) or "numpy" (calls
+    local : "numba" (the kernels of :mod:`shadelab.shading.kernels`, fast) or "numpy" (calls
         :func:`shadelab.shading.reference.shade` itself); the two agree to 1e-9 (tested)
     """
 
@@ -117,8 +120,8 @@ class TraceContext:
         self.specular = scene.render.specular
         self.shadow_rays = 0  # counter, for rays/s figures
         self.workspace = Workspace()  # the Whitted kernels' scratch (one batch at a time)
-        self.material_table = kernels.material_table(self.materials)
-        self.light_table = kernels.light_table(self.lights)
+        self.material_table = packing.material_table(self.materials)
+        self.light_table = packing.light_table(self.lights)
         self.Ia = np.asarray(scene.Ia, dtype=np.float64)
         mats = self.materials
         self.kr = np.array([m.mirror for m in mats], dtype=np.float64)
@@ -133,7 +136,7 @@ class TraceContext:
         g = self.geometry
         tri = hits.tri
         if self.kernels:
-            return Surface(*kernels.surface_frame(
+            return Surface(*surface_rays.surface_frame(
                 np.ascontiguousarray(origins), np.ascontiguousarray(dirs), hits.t, tri,
                 hits.u, hits.v, g.corner_normals, g.face_normals, g.object_index), hits=hits)
         position = origins + hits.t[:, None] * dirs
@@ -189,7 +192,7 @@ class TraceContext:
             if not self.shadows:
                 factors.append(np.ones(len(pos)))
                 continue
-            origin, dirs, tmax, facing = kernels.shadow_rays(pos, ng, self.light_table, k,
+            origin, dirs, tmax, facing = surface_rays.shadow_rays(pos, ng, self.light_table, k,
                                                              self.eps, T_INF)
             s = np.zeros(len(pos))
             idx = np.flatnonzero(facing)
@@ -258,17 +261,17 @@ class TraceContext:
         active = np.arange(m)
         ws = self.workspace
         # Each crossing: one closest-hit query of the rays still carrying light, and one
-        # kernel (kernels.transmit_step) for the filter and the restart, in place
+        # kernel (hits.transmit_step) for the filter and the restart, in place
         for _ in range(MAX_SHADOW_CROSSINGS):
             k = len(active)
             if k == 0:
                 return trans
             og, dg, lg = ws.get("tr_o", k, 3), ws.get("tr_d", k, 3), ws.get("tr_left", k)
-            kernels.gather_rays(active, o, d, left, og, dg, lg)
+            surface_rays.gather_rays(active, o, d, left, og, dg, lg)
             t, tri, _, _ = self.accel.intersect_raw(og, dg, lg)
             self.shadow_rays += k
             following = ws.get("tr_active", k, 0, np.int64)
-            count = kernels.transmit_step(active, t, tri, trans, o, d, left, g.casts_shadow,
+            count = surface_rays.transmit_step(active, t, tri, trans, o, d, left, g.casts_shadow,
                                           g.object_index, self.object_material,
                                           self._shadow_filter, self.eps, following)
             active = following[:count].copy()
@@ -307,7 +310,7 @@ class TraceContext:
                  else np.zeros((0, 3)))
         n_lights, n = shape
         s = self.workspace.get("shadow3", n_lights * n * 3).reshape(n_lights, n, 3)
-        kernels.shadow_matrix3(s, light, point, np.ascontiguousarray(blocked, dtype=np.bool_),
+        surface_rays.shadow_matrix3(s, light, point, np.ascontiguousarray(blocked, dtype=np.bool_),
                                trans)
         return s
 
@@ -331,7 +334,7 @@ class TraceContext:
         mat = self.material_ids(surf)
         if self.kernels:
             s = (np.stack(shadow) if shadow else np.zeros((0, len(out))))
-            out = kernels.local_shade(surf.position, surf.normal,
+            out = shading_kernels.local_shade(surf.position, surf.normal,
                                       np.ascontiguousarray(-dirs), mat, self.material_table,
                                       self.light_table, self.Ia, self.specular == "blinn",
                                       np.ascontiguousarray(s, dtype=np.float64))
@@ -377,7 +380,7 @@ class TraceContext:
         """The next generation of rays (origins, dirs, weights, pixels) above ``min_weight``."""
         mat = self.material_ids(surf)
         if self.kernels:
-            return kernels.spawn_secondary(surf.position, self.spawn_normals(surf, dirs, mat),
+            return ray_kernels.spawn_secondary(surf.position, self.spawn_normals(surf, dirs, mat),
                                            surf.geo_normal,
                                            surf.entering, np.ascontiguousarray(dirs), mat,
                                            weight, pixel, self.kr, self.kt, self.ior,

@@ -18,6 +18,7 @@ from shadelab.raytrace.surface import TraceContext
 from shadelab.raytrace.whitted import check_settings
 from shadelab.scene.camera import primary_rays
 from shadelab.scene.model import Scene
+from shadelab.shading.lights import light_kind
 from shadelab.shading.reference import light_vectors
 
 RAY_KINDS = ("primary", "shadow", "reflected", "refracted")
@@ -125,7 +126,7 @@ def _shadow_nodes(ctx: TraceContext, surf, shadow: list, weight: np.ndarray,
         to_light, distance = light_vectors(light, surf.position)
         start = surf.position[0] + ctx.eps * surf.geo_normal[0]
         lit = float(np.max(shadow[i][0]))  # S_i, or its largest channel (kt-filtered)
-        end = None if light.kind == "directional" else np.asarray(light.position, float)
+        end = light_kind(light).end()
         blocker = -1
         if lit == 0.0:  # blocked, or the light is behind the surface: find the blocker
             hits = ctx.accel.intersect(start[None], to_light[:1])

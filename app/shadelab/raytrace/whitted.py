@@ -24,10 +24,12 @@ import numpy as np
 
 from shadelab.errors import ShadeLabError
 from shadelab.progress import Progress
-from shadelab.raytrace import kernels
+from shadelab.raytrace import rays as ray_kernels
+from shadelab.raytrace import surface_rays
 from shadelab.raytrace.accel import T_INF, embree_available
 from shadelab.raytrace.surface import TraceContext
 from shadelab.scene.model import Scene
+from shadelab.shading import kernels as shading_kernels
 
 TILE_RAYS = 32768  # primary rays per work unit (keeps a chunk well under 0.2 s)
 
@@ -112,7 +114,7 @@ def trace_batch(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarray, depth:
             stats.primary += len(origins)
         hits = ctx.accel.intersect(origins, dirs)
         # Misses see the background
-        kernels.add_background(out, pixel, weight, hits.hit, ctx.background)
+        ray_kernels.add_background(out, pixel, weight, hits.hit, ctx.background)
         hit = np.flatnonzero(hits.hit)
         if generation == 0:
             stats.primary_hits += len(hit)
@@ -121,7 +123,7 @@ def trace_batch(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarray, depth:
         o, d, w, px = origins[hit], dirs[hit], weight[hit], pixel[hit]
         sub = type(hits)(hits.t[hit], hits.tri[hit], hits.u[hit], hits.v[hit])
         surf = ctx.surface(o, d, sub)
-        kernels.add_weighted(out, px, w, ctx.local(surf, d))
+        ray_kernels.add_weighted(out, px, w, ctx.local(surf, d))
         if generation == depth:
             break
         # Spawn the reflected and refracted generation
@@ -132,9 +134,9 @@ def trace_batch(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarray, depth:
 
 def _shade_per_channel(ctx: TraceContext, color, position, normal, d, mat, blinn: bool,
                        shadow: np.ndarray) -> None:
-    """:func:`kernels.local_shade_into` with kt-filtered S_i (L, k, 3): one pass that scales
-    each channel by its own S_i (``kernels.local_shade_into3``)."""
-    kernels.local_shade_into3(color, position, normal, d, mat, ctx.material_table,
+    """:func:`shading_kernels.local_shade_into` with kt-filtered S_i (L, k, 3): one pass that scales
+    each channel by its own S_i (``shading_kernels.local_shade_into3``)."""
+    shading_kernels.local_shade_into3(color, position, normal, d, mat, ctx.material_table,
                               ctx.light_table, ctx.Ia, blinn, np.ascontiguousarray(shadow), 1.0)
 
 
@@ -166,7 +168,7 @@ def _trace_batch_kernels(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarra
         else:
             t, tri, u, v = np.full(len(origins), np.inf), np.full(len(origins), -1), None, None
         # Misses see the background
-        kernels.add_misses(out, pixel, weight, tri, ctx.background)
+        ray_kernels.add_misses(out, pixel, weight, tri, ctx.background)
         hit = np.flatnonzero(tri >= 0)
         if generation == 0:
             stats.primary_hits += len(hit)
@@ -177,7 +179,7 @@ def _trace_batch_kernels(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarra
         geo = ws.get("geo", k, 3)
         d, w, px = ws.get("d", k, 3), ws.get("w", k, 3), ws.get("px", k, 0, np.int64)
         entering, mat = ws.get("entering", k, 0, np.bool_), ws.get("mat", k, 0, np.int64)
-        kernels.hit_surfaces(origins, dirs, weight, pixel, t, tri, u, v, hit, g.corner_normals,
+        surface_rays.hit_surfaces(origins, dirs, weight, pixel, t, tri, u, v, hit, g.corner_normals,
                              g.face_normals, g.object_index, ctx.object_material, position,
                              normal, geo, entering, mat, d, w, px)
         if not ctx.shadows:
@@ -187,7 +189,7 @@ def _trace_batch_kernels(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarra
             o32, d32, t32 = (ws.get("so", rows, 3, np.float32), ws.get("sd", rows, 3, np.float32),
                              ws.get("st", rows, 0, np.float32))
             light, point = ws.get("sk", rows, 0, np.int64), ws.get("si", rows, 0, np.int64)
-            count = kernels.shadow_batch(position, geo, ctx.light_table, ctx.eps, T_INF, o32,
+            count = surface_rays.shadow_batch(position, geo, ctx.light_table, ctx.eps, T_INF, o32,
                                          d32, t32, light, point)
             blocked = ctx.shadow_occluded(o32[:count], d32[:count], t32[:count])
             stats.shadow += count
@@ -197,7 +199,7 @@ def _trace_batch_kernels(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarra
                                                     point[:count], blocked, o32[:count],
                                                     d32[:count], t32[:count])
             else:
-                shadow = kernels.shadow_matrix(n_lights, k, light[:count], point[:count],
+                shadow = surface_rays.shadow_matrix(n_lights, k, light[:count], point[:count],
                                                blocked)
         else:
             shadow = np.zeros((0, k))
@@ -205,13 +207,13 @@ def _trace_batch_kernels(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarra
         if shadow.ndim == 3:
             _shade_per_channel(ctx, color, position, normal, d, mat, blinn, shadow)
         else:
-            kernels.local_shade_into(color, position, normal, d, mat, ctx.material_table,
+            shading_kernels.local_shade_into(color, position, normal, d, mat, ctx.material_table,
                                      ctx.light_table, ctx.Ia, blinn, shadow, 1.0)
         if ctx.detail.active:  # textured materials: Od(u, v) and bumped normals, reshaded
             ctx.detail.reshade(color, position, normal, d, mat, tri[hit],
                                np.asarray(u[hit], np.float64), np.asarray(v[hit], np.float64),
                                shadow)
-        kernels.add_weighted(out, px, w, color)
+        ray_kernels.add_weighted(out, px, w, color)
         if generation == depth:
             break
         # Spawn the reflected and refracted generation (into the other set of buffers)
@@ -220,7 +222,7 @@ def _trace_batch_kernels(ctx: TraceContext, origins: np.ndarray, dirs: np.ndarra
         if ctx.detail.active:  # mirror and refracted rays leave about the bumped normal
             normal = ctx.detail.bumped(normal, d, mat, tri[hit], np.asarray(u[hit], np.float64),
                                        np.asarray(v[hit], np.float64))
-        count = kernels.spawn_secondary_into(new_o, new_d, new_w, new_p, position, normal, geo,
+        count = ray_kernels.spawn_secondary_into(new_o, new_d, new_w, new_p, position, normal, geo,
                                              entering, d, mat, w, px, ctx.kr, ctx.kt, ctx.ior,
                                              ctx.tint, fresnel, min_weight, ctx.eps)
         origins, dirs, weight, pixel = new_o[:count], new_d[:count], new_w[:count], new_p[:count]
@@ -325,7 +327,7 @@ def _tile_rays(scene: Scene, size: tuple[int, int], spp: int, seed: int, workspa
             origins, dirs = np.empty((n, 3)), np.empty((n, 3))
         else:
             origins, dirs = workspace.get("camera_o", n, 3), workspace.get("camera_d", n, 3)
-        kernels.camera_rays_into(origins, dirs, eye, forward, right, up, tan_half, width,
+        ray_kernels.camera_rays_into(origins, dirs, eye, forward, right, up, tan_half, width,
                                  height, r0, r1, tile)
         return origins, dirs
 

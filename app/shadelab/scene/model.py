@@ -21,7 +21,8 @@ MAX_LIGHTS = 16  # the GLSL light arrays hold this many
 
 SHADING_MODES = ("flat", "gouraud", "phong")
 SPECULAR_MODELS = ("phong", "blinn")
-LIGHT_KINDS = ("point", "directional", "spot")
+LIGHT_KINDS = ("point", "directional", "spot")  # shadelab.shading.lights: one class each
+AIMED_LIGHT_KINDS = ("directional", "spot")  # kinds whose direction must be non-zero
 ATTENUATION_MODES = ("none", "inverse_square", "lecture")
 NORMALS_MODES = ("flat", "average", "area", "angle", "crease")
 SHAPES = ("sphere", "box", "plane", "quad", "cylinder", "cone", "torus", "capsule", "mesh")

@@ -23,6 +23,7 @@ from shadelab.paths import OutputSet, file_problem, output_problem, resolve_link
 from shadelab.progress import steps
 from shadelab.resources import presets_dir
 from shadelab.scene.model import (
+    AIMED_LIGHT_KINDS,
     MAX_LIGHTS,
     SCHEMA_VERSION,
     Camera,
@@ -337,7 +338,7 @@ def _cross_check(scene: Scene, source: str) -> None:
         if min(abs(s) for s in obj.scale) == 0.0:
             raise ShadeLabError(f"{source}: key 'objects.{i}.scale': expected non-zero scales")
     for i, light in enumerate(scene.lights):
-        if light.kind != "point" and sum(d * d for d in light.direction) == 0.0:
+        if light.kind in AIMED_LIGHT_KINDS and sum(d * d for d in light.direction) == 0.0:
             raise ShadeLabError(f"{source}: key 'lights.{i}.direction': expected a non-zero vector")
         if light.attenuation == "lecture" and light.c1 + light.c2 + light.c3 == 0.0:
             # f_att = min(1/0, 1) = 1: allowed, the clamp makes it finite (failure gallery)

@@ -7,15 +7,28 @@ a code is written by hand anywhere else.
 from __future__ import annotations
 
 from shadelab.constants import SHADING_EPS
-from shadelab.scene.model import ATTENUATION_MODES, LIGHT_KINDS, MAX_LIGHTS, SPECULAR_MODELS
+from shadelab.scene.model import (
+    AIMED_LIGHT_KINDS,
+    ATTENUATION_MODES,
+    LIGHT_KINDS,
+    MAX_LIGHTS,
+    SPECULAR_MODELS,
+)
+from shadelab.shading.lights import LIGHT_CLASSES
 
-LIGHT_KIND_CODES = {"point": 0, "directional": 1, "spot": 2}  # Light.kind
+LIGHT_KIND_CODES = {cls.kind: cls.code for cls in LIGHT_CLASSES}  # Light.kind, from lights.py
 ATTENUATION_CODES = {"none": 0, "inverse_square": 1, "lecture": 2}  # Light.attenuation
 SPECULAR_CODES = {"phong": 0, "blinn": 1}  # (R.V)^n or (N.H)^n
 
 assert tuple(LIGHT_KIND_CODES) == LIGHT_KINDS
+assert tuple(cls.kind for cls in LIGHT_CLASSES if cls.aimed) == AIMED_LIGHT_KINDS
 assert tuple(ATTENUATION_CODES) == ATTENUATION_MODES
 assert tuple(SPECULAR_CODES) == SPECULAR_MODELS
+# A shader variant packs each light's kind and attenuation codes in CODE_BITS bits
+# (Renderer.light_defines, LIGHT_KIND(i) in lighting.glsl)
+CODE_BITS = 2
+assert max(LIGHT_KIND_CODES.values()) < 1 << CODE_BITS
+assert max(ATTENUATION_CODES.values()) < 1 << CODE_BITS
 
 # GLSL name prefix of each table: LIGHT_SPOT, ATTENUATION_LECTURE, SPECULAR_BLINN
 _GLSL_TABLES = (("LIGHT", LIGHT_KIND_CODES), ("ATTENUATION", ATTENUATION_CODES),

@@ -16,17 +16,9 @@ import numpy as np
 
 from shadelab.constants import SHADING_EPS as _EPS
 from shadelab.scene.model import Light, Material
-from shadelab.shading.codes import ATTENUATION_CODES  # noqa: F401  (re-exported)
-
-
-def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return np.sum(a * b, axis=-1)
-
-
-def normalize(v: np.ndarray) -> np.ndarray:
-    """Unit vectors; a zero vector stays zero instead of becoming NaN."""
-    length = np.linalg.norm(v, axis=-1, keepdims=True)
-    return np.where(length > _EPS, v / np.maximum(length, _EPS), 0.0)
+from shadelab.shading.lights import attenuation, light_kind, spot_factor  # noqa: F401
+from shadelab.shading.vectors import dot as _dot
+from shadelab.shading.vectors import normalize
 
 
 def lambert(n: np.ndarray, to_light: np.ndarray) -> np.ndarray:
@@ -84,30 +76,6 @@ def blinn_phong_specular(n: np.ndarray, to_light: np.ndarray, to_eye: np.ndarray
     return np.where(lit, _power(_dot(n, halfway(to_light, to_eye)), shininess), 0.0)
 
 
-def attenuation(distance: np.ndarray, mode: str, c1: float, c2: float, c3: float) -> np.ndarray:
-    """Light-source attenuation f_att at ``distance`` (inf for a directional light: 1).
-
-    Notes
-    -----
-    none:           f_att = 1
-    inverse_square: f_att = 1 / d^2
-    lecture:        f_att = min(1 / (c1 + c2 d + c3 d^2), 1)
-    """
-    d = np.asarray(distance, dtype=np.float64)
-    finite = np.isfinite(d)
-    dd = np.where(finite, d, 0.0)
-    if mode == "none":
-        f = np.ones_like(dd)
-    elif mode == "inverse_square":
-        f = 1.0 / np.maximum(dd * dd, _EPS)
-    elif mode == "lecture":
-        denominator = c1 + c2 * dd + c3 * dd * dd
-        f = np.minimum(1.0 / np.maximum(denominator, _EPS), 1.0)
-    else:
-        raise ValueError(f"unknown attenuation mode {mode!r}")
-    return np.where(finite, f, 1.0)
-
-
 def attenuation_clamped(distance: np.ndarray, light: Light) -> np.ndarray:
     """True where the lecture's min(..., 1) clamp is active (the probe shows it)."""
     if light.attenuation != "lecture":
@@ -118,32 +86,13 @@ def attenuation_clamped(distance: np.ndarray, light: Light) -> np.ndarray:
     return finite & ((light.c1 + light.c2 * dd + light.c3 * dd * dd) <= 1.0)
 
 
-def spot_factor(to_light: np.ndarray, axis: np.ndarray, cos_cone: float,
-                exponent: float) -> np.ndarray:
-    """Spotlight cone (Warn): (cos phi)^e inside the cone, 0 outside.
-
-    Notes
-    -----
-    cos phi = (-L) . D, with D the unit spot axis; inside when phi <= cone angle.
-    """
-    cos_phi = _dot(-to_light, axis)
-    inside = cos_phi >= cos_cone
-    return np.where(inside, np.power(np.maximum(cos_phi, 0.0), exponent), 0.0)
-
-
 def light_vectors(light: Light, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Unit ``to_light`` vectors and distances from surface points to a light.
 
-    A directional light is at infinite distance along ``-direction``.
+    A directional light is at infinite distance along ``-direction``
+    (:meth:`shadelab.shading.lights.LightKind.to_light`).
     """
-    position = np.asarray(position, dtype=np.float64)
-    if light.kind == "directional":
-        to_light = normalize(-np.asarray(light.direction, dtype=np.float64))
-        to_light = np.broadcast_to(to_light, position.shape)
-        return to_light, np.full(position.shape[:-1], np.inf)
-    delta = np.asarray(light.position, dtype=np.float64) - position
-    distance = np.linalg.norm(delta, axis=-1)
-    return normalize(delta), distance
+    return light_kind(light).to_light(position)
 
 
 @dataclass
@@ -238,14 +187,10 @@ def shade_terms(position: np.ndarray, normal: np.ndarray, eye: np.ndarray, mater
     spec_fn = blinn_phong_specular if specular == "blinn" else phong_specular
     terms = []
     for i, light in enumerate(lights):
-        to_light, distance = light_vectors(light, position)
-        f_att = attenuation(distance, light.attenuation, light.c1, light.c2, light.c3)
-        if light.kind == "spot":
-            axis = normalize(np.asarray(light.direction, dtype=np.float64))
-            spot = spot_factor(to_light, axis, np.cos(np.radians(light.cone_angle)),
-                               light.spot_exponent)
-        else:
-            spot = np.ones(shape)
+        kind = light_kind(light)
+        to_light, distance = kind.to_light(position)
+        f_att = kind.attenuation(distance)
+        spot = kind.spot(to_light)
         s = np.ones(shape) if shadow is None else np.asarray(shadow[i], dtype=np.float64)
         rgb = s.shape == shape + (3,) and shadow is not None   # kt-filtered S_i per channel
         if not rgb:
