@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import shadelab
-from shadelab import pipelines
+from shadelab import api, pipelines
 from shadelab.cli import main
 from shadelab.errors import ShadeLabError
 from shadelab.progress import Progress
@@ -54,7 +54,7 @@ def test_render_accepts_a_registered_pipeline(albedo):
     np.testing.assert_array_equal(image.array, expected(10, 6))  # exact: a constant
     assert image.info["pipeline"] == "albedo" and image.size == (10, 6)
     assert shadelab.render("cornell", pipeline="albedo").size == (12, 8)  # its default size
-    assert "albedo" in shadelab.api.PIPELINES
+    assert "albedo" in api.PIPELINES
     with pytest.raises(ShadeLabError, match="applies to the raster and painter"):
         shadelab.render("cornell", pipeline="albedo", shading="flat")
 
