@@ -55,3 +55,16 @@ def test_render_by_shading_name_equals_raster_with_that_shading(gl_ctx, shading)
     by_flag = shadelab.render("cornell", size=(40, 30), shading=shading)
     np.testing.assert_array_equal(by_name.array, by_flag.array)  # same renderer, exact
     assert by_name.info["shading"] == shading and by_name.array.max() > 0.0
+
+
+def test_builtins_pickle_by_name_when_imported_before_the_registry(tmp_path):
+    """lab.pipeline_jobs imports pipelines.radiosity directly: it is still a built-in."""
+    import subprocess
+    import sys
+
+    code = ("import pickle, shadelab.lab.pipeline_jobs\n"
+            "from shadelab import pipelines\n"
+            "p = pipelines.get('radiosity')\n"
+            "assert pickle.loads(pickle.dumps(p)) is p\nprint('ok')")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert out.stdout.strip() == "ok", out.stderr[-2000:]

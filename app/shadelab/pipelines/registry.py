@@ -57,6 +57,8 @@ def register(pipeline):
         if not hasattr(instance, attr):
             raise ShadeLabError(f"pipeline '{name}': has no {attr}")
     _REGISTRY[name] = instance
+    if type(instance).__module__.rsplit(".", 1)[0] == __package__:
+        _BUILTIN.add(name)  # a module of this package (imported directly or by the loader)
     return pipeline
 
 
