@@ -28,16 +28,23 @@ import numpy as np
 from shadelab.errors import ShadeLabError
 from shadelab.scene.model import SHADING_MODES, SPECULAR_MODELS, Scene
 
-__all__ = ["PIPELINES", "Image", "ShadeLabError", "load_preset", "save_preset", "list_presets",
-           "render", "probe", "show"]
+__all__ = ["PIPELINES", "Image", "ShadeLabError", "load_preset",  # noqa: F822  (PIPELINES:
+           "save_preset", "list_presets", "render", "probe", "show"]  # from the registry)
 
-#: What :func:`render` can run; ``raster`` is the z-buffered GL renderer (flat, Gouraud or
-#: Phong shading), ``painter`` the same with list-priority visibility.
-PIPELINES = ("raster", "painter", "raytrace", "pathtrace", "radiosity")
 
-#: The image size each pipeline uses when none is given, as the CLI's defaults.
-DEFAULT_SIZES = {"raster": (800, 600), "painter": (800, 600), "raytrace": (512, 512),
-                 "pathtrace": (256, 256), "radiosity": (512, 512)}
+
+def __getattr__(name: str):
+    """``PIPELINES`` and ``DEFAULT_SIZES`` are read from :mod:`shadelab.pipelines` when asked
+    for, so a pipeline registered later (a plugin, a test) is listed too."""
+    from shadelab import pipelines
+
+    if name == "PIPELINES":
+        #: What :func:`render` can run: ``raster`` (the GL z-buffer with the scene's shading),
+        #: then every registered pipeline (painter, gouraud, phong, flat, radiosity, ...).
+        return pipelines.all_names()
+    if name == "DEFAULT_SIZES":
+        return {n: tuple(pipelines.get(n).default_size) for n in pipelines.all_names()}
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 # ---------------------------------------------------------------- images
@@ -201,7 +208,9 @@ def _size(size: Any, pipeline: str) -> tuple[int, int]:
     from shadelab.imageio import parse_size
 
     if size is None:
-        return DEFAULT_SIZES[pipeline]
+        from shadelab import pipelines
+
+        return tuple(pipelines.get(pipeline).default_size)
     if isinstance(size, str):
         return parse_size(size)
     if isinstance(size, (int, np.integer)) and not isinstance(size, bool):
@@ -233,9 +242,11 @@ def render(scene: Scene | str, size: Any = None, shading: str | None = None,
         Default: the CLI's size for the pipeline (800x600 raster, 512x512 ray tracing and
         radiosity, 256x256 path tracing).
     shading : {"flat", "gouraud", "phong"}, optional
-        Raster and painter pipelines only; default the scene's ``render.shading``.
-    pipeline : {"raster", "painter", "raytrace", "pathtrace", "radiosity"}
-        ``raster``: GL z-buffer (``shadelab render``); ``painter``: list priority
+        ``raster`` and ``painter`` only; default the scene's ``render.shading``.
+    pipeline : str
+        A name of :func:`shadelab.pipelines.names` or ``raster``.
+        ``raster``: GL z-buffer with the scene's shading (``shadelab render``); ``gouraud``,
+        ``phong``, ``flat``: the same with that shading; ``painter``: list priority
         (``--visibility painter``); ``raytrace``: Whitted (``shadelab raytrace``);
         ``pathtrace``: Monte Carlo reference (``shadelab pathtrace``); ``radiosity``: solved
         patches shown Gouraud-shaded (``shadelab radiosity``).
@@ -260,12 +271,14 @@ def render(scene: Scene | str, size: Any = None, shading: str | None = None,
         ``.array`` is float32 linear radiance, shape (H, W, 3), row 0 at the top, aligned
         pixel for pixel across pipelines; ``.info`` holds the pipeline and its statistics.
     """
+    from shadelab import pipelines
+
     scene = _scene(scene)
-    if pipeline not in PIPELINES:
-        raise ShadeLabError(f"pipeline '{pipeline}': expected one of {', '.join(PIPELINES)}")
+    chosen = pipelines.get(pipeline)
+    accepts = set(getattr(chosen, "options", ()))
     if shading is not None and shading not in SHADING_MODES:
         raise ShadeLabError(f"shading '{shading}': expected one of {', '.join(SHADING_MODES)}")
-    if shading is not None and pipeline not in ("raster", "painter"):
+    if shading is not None and "shading" not in accepts:
         raise ShadeLabError(f"shading '{shading}': applies to the raster and painter "
                             f"pipelines, not {pipeline}")
     if specular is not None and specular not in SPECULAR_MODELS:
@@ -274,58 +287,22 @@ def render(scene: Scene | str, size: Any = None, shading: str | None = None,
     wh = _size(size, pipeline)
     exposure = scene.render.exposure
     info: dict[str, Any] = {"pipeline": pipeline, "size": wh}
-    if pipeline in ("raster", "painter"):
-        from shadelab.raster.offscreen import render_image
+    given = {"shading": shading, "specular": specular, "depth": depth, "spp": spp,
+             "seed": seed, "fresnel": fresnel, "patches": patches,
+             "form_factors": form_factors, "solver": solver, "backend": backend,
+             "workers": workers}
+    options = {k: v for k, v in given.items() if k in accepts and v is not None}
+    if getattr(chosen, "raster", None) is None:  # the CPU pipelines: one set of checks
+        from shadelab.cli.raytrace import _check_counts
 
-        if pipeline == "painter" and scene.render.visibility != "painter":
-            scene = copy.deepcopy(scene)
-            scene.render.visibility = "painter"
-        info["shading"] = shading or scene.render.shading
-        return Image(render_image(scene, wh, shading, specular), exposure, info)
-    from shadelab.cli.raytrace import _check_counts, _check_scene
+        _check_counts(depth if "depth" in accepts else None, spp, workers)
+    chosen.check(scene, scene.name or "scene")
     from shadelab.progress import run_to_end
 
-    label = scene.name or "scene"
-    _check_counts(depth if pipeline == "raytrace" else None, spp, workers)
-    if pipeline == "raytrace":
-        _check_scene(scene, label)
-        if not scene.active_lights():
-            raise ShadeLabError(f"{label}: lights: the ray tracer needs at least one "
-                                "enabled light")
-        from shadelab.raytrace.whitted import iter_raytrace
-
-        last = run_to_end(iter_raytrace(scene, wh, depth, spp, fresnel, backend,
-                                        workers=workers), desc="raytrace", show=progress)
-        info.update(last.stats)
-        return Image(last.image, exposure, info)
-    if pipeline == "pathtrace":
-        _check_scene(scene, label)
-        from shadelab.raytrace.pathtrace import check_lit, iter_pathtrace
-
-        check_lit(scene, label)
-
-        spp = 64 if spp is None else spp
-        last = run_to_end(iter_pathtrace(scene, wh, spp, seed, backend, workers=workers),
-                          desc="pathtrace", show=progress)
-        info.update(last.stats, spp=spp)
-        return Image(last.image, exposure, info)
-    # radiosity, as shadelab radiosity does it
-    if patches is not None:
-        from shadelab.radiosity.patches import check_count
-
-        check_count(patches)
-    from shadelab.radiosity.solution import iter_radiosity, precheck
-
-    precheck(scene, patches or scene.radiosity.patches,
-             form_factors or scene.radiosity.form_factors)
-    last = run_to_end(iter_radiosity(scene, None, patches, form_factors, solver),
-                      desc="radiosity", show=progress)
-    solution = last.stats["solution"]
-    from shadelab.raster.radiosity_image import render_solution
-
-    stats = {k: v for k, v in solution.stats.items() if k != "history"}
-    info.update(stats)
-    return Image(render_solution(solution, wh), exposure, info)
+    last = run_to_end(chosen.run(scene, wh, **options), desc=chosen.name,
+                      show=progress and getattr(chosen, "raster", None) is None)
+    info.update(chosen.info(last, options))
+    return Image(chosen.image(last, wh, **options), exposure, info)
 
 
 # ---------------------------------------------------------------- the probe

@@ -44,7 +44,7 @@ def run_radiosity(args: argparse.Namespace) -> int:
 
         check_budget(args.error)
     check_outputs(args)
-    from shadelab.raster.radiosity import iter_radiosity, precheck  # with the GPU hemicube
+    from shadelab.radiosity.solution import precheck
 
     if getattr(args, "error", None) is not None:
         from shadelab.studies.radiosity_study import auto_radiosity
@@ -57,15 +57,14 @@ def run_radiosity(args: argparse.Namespace) -> int:
         args.uniform = True
         print(line)
 
-    precheck(scene, args.patches or scene.radiosity.patches,
-             args.form_factors or scene.radiosity.form_factors)
-    job = iter_radiosity(scene, None, args.patches, args.form_factors, args.solver,
-                         adaptive=not args.uniform)
+    from shadelab import pipelines
+
+    radiosity = pipelines.get("radiosity")
+    job = radiosity.run(scene, None, args.patches, args.form_factors, args.solver,
+                        adaptive=not args.uniform, gpu=True)  # GPU hemicube available here
     last = run_to_end(job, desc="radiosity")
     solution = last.stats["solution"]
-    from shadelab.raster.radiosity_image import render_solution  # GL only once solved
-
-    image = render_solution(solution, size)
+    image = radiosity.image(last, size)  # GL only once solved
     save_outputs(args, image, scene.render.exposure)
     stats = solution.stats
     print(f"wrote {args.output} ({size[0]}x{size[1]}): {stats['patches']} patches, "

@@ -87,8 +87,8 @@ def run_raytrace(args: argparse.Namespace) -> int:
 
         check_budget(args.error)
     check_outputs(args)
+    from shadelab import pipelines
     from shadelab.progress import run_to_end
-    from shadelab.raytrace.whitted import iter_raytrace
 
     if getattr(args, "error", None) is not None:
         from shadelab.studies.raytrace_study import auto_raytrace
@@ -96,8 +96,9 @@ def run_raytrace(args: argparse.Namespace) -> int:
         args.depth, args.spp, line = auto_raytrace(scene, size, args.error)
         print(line)
 
-    last = run_to_end(iter_raytrace(scene, size, args.depth, args.spp, args.fresnel,
-                                    args.backend, workers=args.workers), desc="raytrace")
+    job = pipelines.get("raytrace").run(scene, size, args.depth, args.spp, args.fresnel,
+                                        args.backend, workers=args.workers)
+    last = run_to_end(job, desc="raytrace")
     save_outputs(args, last.image, scene.render.exposure)
     _note_if_nothing_visible(last.stats)
     s = last.stats
@@ -115,14 +116,15 @@ def run_pathtrace(args: argparse.Namespace) -> int:
     _check_scene(scene, args.preset)
     limits.check_pixels(size)
     limits.check_samples(size, args.spp)
-    from shadelab.raytrace.pathtrace import check_lit, iter_pathtrace
+    from shadelab import pipelines
 
-    check_lit(scene, args.preset)
+    pathtrace = pipelines.get("pathtrace")
+    pathtrace.check(scene, args.preset)
     check_outputs(args)
     from shadelab.progress import run_to_end
 
-    last = run_to_end(iter_pathtrace(scene, size, args.spp, args.seed, args.backend,
-                                     workers=args.workers), desc="pathtrace")
+    last = run_to_end(pathtrace.run(scene, size, args.spp, args.seed, args.backend,
+                                    workers=args.workers), desc="pathtrace")
     save_outputs(args, last.image, scene.render.exposure)
     _note_if_nothing_visible(last.stats)
     s = last.stats

@@ -33,6 +33,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--error", type=float, metavar="BUDGET",
                    help="auto quality: tessellate each sphere no finer than this relative MSE "
                         "needs (e.g. 0.01; see shadelab.studies.autoquality)")
+    p.add_argument("--pipeline", metavar="NAME",
+                   help="any pipeline of shadelab.pipelines (default raster: the GL z-buffer; "
+                        "gouraud, phong, flat, painter, raytrace, pathtrace, radiosity, ...), "
+                        "with its default settings")
     p.add_argument("-v", "--verbose", action="store_true",
                    help="print the OpenGL context used (egl or native, SHADELAB_GL) and its "
                         "renderer")
@@ -47,8 +51,25 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(run=run_validate)
 
 
+RASTER_FLAGS = ("shading", "specular", "shadows", "shadow_method", "visibility", "error")
+
+
 def run_render(args: argparse.Namespace) -> int:
     size = parse_size(args.size)
+    name = getattr(args, "pipeline", None)
+    if name and name != "raster":
+        from shadelab import pipelines
+
+        pipeline = pipelines.get(name, "--pipeline")
+        if pipeline.raster is None:
+            return run_pipeline(args, pipeline, size)
+        shading, visibility = pipeline.raster
+        if name != "painter":
+            if args.shading and args.shading != shading:
+                raise ShadeLabError(f"--shading {args.shading}: the {name} pipeline shades "
+                                    f"{shading}")
+            args.shading = shading
+        args.visibility = visibility
     overrides = list(args.set)
     for flag, key in (("shadows", "render.shadows"), ("shadow_method", "render.shadow_method")):
         if getattr(args, flag, None):
@@ -65,7 +86,7 @@ def run_render(args: argparse.Namespace) -> int:
 
         check_budget(args.error)
     check_outputs(args)
-    from shadelab.raster.offscreen import render_image  # GL only once the input is known good
+    from shadelab import pipelines  # GL (inside run) only once the input is known good
 
     if getattr(args, "error", None) is not None:
         from shadelab.studies.autoquality import auto_tessellate
@@ -74,7 +95,8 @@ def run_render(args: argparse.Namespace) -> int:
         for line in auto_tessellate(scene, shading, size, args.error, args.specular):
             print(line)
 
-    image = render_image(scene, size, args.shading, args.specular)
+    *_, last = pipelines.get("raster").run(scene, size, args.shading, args.specular)
+    image = last.image
     if getattr(args, "verbose", False):
         from shadelab.gl.context import context_info, headless_context
 
@@ -82,6 +104,25 @@ def run_render(args: argparse.Namespace) -> int:
         print(f"gl: {gl['backend']}, {gl['renderer']}, OpenGL {gl['version']}")
     save_outputs(args, image, scene.render.exposure)
     print(f"wrote {args.output} ({size[0]}x{size[1]}, {args.shading or scene.render.shading})")
+    return 0
+
+
+def run_pipeline(args: argparse.Namespace, pipeline, size: tuple[int, int]) -> int:
+    """``render --pipeline NAME`` for a CPU pipeline: its defaults, the generic path."""
+    for flag in RASTER_FLAGS:
+        if getattr(args, flag, None) is not None:
+            option = "--" + flag.replace("_", "-")
+            raise ShadeLabError(f"{option}: applies to the raster pipelines, not "
+                                f"{pipeline.name}")
+    scene = load_preset(args.preset, list(args.set))
+    pipeline.check(scene, args.preset)
+    limits.check_pixels(size, bytes_per_pixel=64)
+    check_outputs(args)
+    from shadelab.progress import run_to_end
+
+    last = run_to_end(pipeline.run(scene, size), desc=pipeline.name)
+    save_outputs(args, pipeline.image(last, size), scene.render.exposure)
+    print(f"wrote {args.output} ({size[0]}x{size[1]}, {pipeline.name})")
     return 0
 
 

@@ -64,11 +64,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def check_job(name: str) -> None:
-    """--job names an offline renderer (a prefix of its label), checked before the window."""
-    from shadelab.lab.jobs import available_jobs
+    """--job names an offline renderer (its pipeline name or a prefix of its label), checked
+    before the window."""
+    from shadelab.lab.jobs import available_jobs, find_job
 
     labels = [kind.label for kind in available_jobs()]
-    if not name.strip() or not any(label.lower().startswith(name.lower()) for label in labels):
+    if not name.strip() or find_job(name) is None:
         raise ShadeLabError(f"--job '{name}': expected one of reference, whitted, path, "
                             f"radiosity (a prefix of: {'; '.join(labels)})")
 
@@ -171,11 +172,11 @@ def run_view(args: argparse.Namespace) -> int:
         raise ShadeLabError(f"--frames {args.frames}: expected a count >= 0")
     _check_study_and_case(args)
     if args.pipeline:
-        from shadelab.lab.pipeline_jobs import PIPELINE_NAMES
+        from shadelab.pipelines import viewport_names
 
-        if args.pipeline not in PIPELINE_NAMES:
+        if args.pipeline not in viewport_names():
             raise ShadeLabError(f"--pipeline '{args.pipeline}': expected one of "
-                                f"{', '.join(PIPELINE_NAMES)}")
+                                f"{', '.join(viewport_names())}")
     run = None
     notes: list[str] = []   # a damaged autosaved session, for the status line
     if args.step != 1 and not args.lesson:

@@ -5,8 +5,8 @@ numba compilation or a GIL-holding kernel never stalls the UI, and a cancel that
 within ``KILL_AFTER`` seconds ends the process; anything else (a closure, a test's generator)
 runs in a worker thread. Either way the UI polls :meth:`JobRunner.snapshot`.
 
-The renderers (Whitted, path tracer, radiosity) are found lazily, so the viewer runs whether or
-not those layers exist yet; a missing one is listed as "not available" with the reason.
+The jobs on offer are the pipelines of :mod:`shadelab.pipelines` that have a ``job_label``
+(:func:`available_jobs`); :meth:`JobRunner.start_pipeline` starts one by its registry name.
 Pure module: threads, processes and numpy only, no GL.
 """
 
@@ -26,7 +26,6 @@ from typing import Callable, Iterator
 import numpy as np
 
 from shadelab.progress import Progress
-from shadelab.scene.camera import primary_rays
 from shadelab.scene.model import Scene
 from shadelab.scene.preset import clone_scene
 
@@ -203,6 +202,22 @@ class JobRunner:
                                         name=f"shadelab-job-{name}")
         self._thread.start()
 
+    def start_pipeline(self, name: str, scene: Scene, size: tuple[int, int],
+                       viewport: bool = False) -> None:
+        """Start registry pipeline ``name``'s job (``viewport``: its coarse-to-fine job) on a
+        copy of ``scene``; a pipeline the worker process cannot look up runs in a thread."""
+        from functools import partial
+
+        from shadelab import pipelines
+
+        pipeline = pipelines.get(name)
+        scene = clone_scene(scene)
+        factory = partial(pipelines.viewport_job if viewport else pipelines.run_job, name)
+        if not _pickles(pipeline):
+            def factory(scene, size, p=pipeline):  # noqa: F811
+                return p.viewport_job(scene, size) if viewport else p.job(scene, size)
+        self.start(name, lambda: factory(scene, size), call=(factory, scene, size))
+
     def _publish(self, step: Progress) -> None:
         """Make ``step`` the newest Progress (under the lock) and note it in the trail."""
         self.latest = step
@@ -282,42 +297,7 @@ class JobRunner:
 
 # ---------------------------------------------------------------- the jobs on offer
 
-
-def iter_reference_raster(scene: Scene, size: tuple[int, int], rows_per_chunk: int = 8):
-    """A CPU render with the numpy reference (ray cast + Phong-mode shading), rows at a time.
-
-    Always available: it checks the GPU image pixel for pixel and exercises the job panel.
-    """
-    from shadelab.geometry.mesh import scene_meshes
-    from shadelab.lab.probe import Picker, _facing
-    from shadelab.shading.reference import normalize, shade
-
-    scene = clone_scene(scene)
-    width, height = size
-    meshes = scene_meshes(scene)
-    picker = Picker(scene, meshes)
-    origins, directions = primary_rays(scene.camera, width, height)
-    image = np.zeros((height, width, 3), np.float32)
-    eye = np.asarray(scene.camera.eye, dtype=np.float64)
-    for y0 in range(0, height, rows_per_chunk):
-        o = origins[y0:y0 + rows_per_chunk].reshape(-1, 3)
-        d = directions[y0:y0 + rows_per_chunk].reshape(-1, 3)
-        mesh_id, face, t, bary = picker.hits(o, d)
-        out = np.zeros((len(o), 3))
-        for m, mesh in enumerate(meshes):
-            sel = np.flatnonzero(mesh_id == m)
-            if not len(sel):
-                continue
-            f = face[sel]
-            p = o[sel] + t[sel, None] * d[sel]
-            n = normalize(np.einsum("ij,ijk->ik", bary[sel], mesh.corner_normals[f]))
-            n = _facing(n, mesh.face_normals[f], normalize(eye - p))
-            out[sel] = shade(p, n, eye, scene.materials[mesh.material], scene.active_lights(),
-                             scene.Ia, scene.render.specular)
-        image[y0:y0 + rows_per_chunk] = out.reshape(-1, width, 3)
-        done = min(y0 + rows_per_chunk, height)
-        yield Progress(image.copy(), done / height, f"rows {done}/{height}")
-    yield Progress(image, 1.0, "done", {"pixels": width * height})
+from shadelab.pipelines.reference import iter_reference_raster  # noqa: E402,F401
 
 
 @dataclass
@@ -328,18 +308,8 @@ class JobKind:
     make: JobFactory | None     # None: not available
     reason: str = ""            # why not, when make is None
     raster_shading: str = "phong"  # the raster view it is compared against
-
-
-def _lookup(module: str, names: tuple[str, ...]):
-    """The first of ``names`` in ``module``, or (None, reason)."""
-    try:
-        mod = importlib.import_module(module)
-    except ImportError as exc:
-        return None, f"{module} not available ({exc})"
-    for name in names:
-        if hasattr(mod, name):
-            return getattr(mod, name), ""
-    return None, f"{module} has none of {', '.join(names)}"
+    pipeline: str = ""          # its name in shadelab.pipelines ("" for a test's own job)
+    samples: bool = False       # it takes the scene's samples per pixel (the panel's slider)
 
 
 def _pickles(value) -> bool:
@@ -350,60 +320,47 @@ def _pickles(value) -> bool:
         return False
 
 
-WHITTED = (("shadelab.raytrace", "shadelab.raytrace.whitted", "shadelab.raytrace.tracer"),
-           ("iter_whitted", "iter_raytrace"))
-PATHTRACE = (("shadelab.raytrace.pathtrace",), ("iter_pathtrace",))
-RADIOSITY = (("shadelab.radiosity", "shadelab.radiosity.solver"), ("iter_radiosity",))
-
-
-def _find(spec) -> tuple[Callable | None, str]:
-    modules, names = spec
-    reason = ""
-    for module in modules:
-        fn, reason = _lookup(module, names)
-        if fn is not None:
-            return fn, ""
-    return None, reason
-
-
 def warm_up(scene, size) -> Iterator[Progress]:
     """Import every renderer (numba caches load, embree starts); yields nothing."""
-    for modules, _ in (WHITTED, PATHTRACE, RADIOSITY):
-        for module in modules:
-            try:
-                importlib.import_module(module)
-            except ImportError:
-                pass
+    for module in ("shadelab.raytrace.whitted", "shadelab.raytrace.pathtrace",
+                   "shadelab.radiosity.solution"):
+        try:
+            importlib.import_module(module)
+        except ImportError:
+            pass
     return iter(())
 
 
-# Module-level factories (picklable by reference, so they run in the worker process).
-def run_whitted(scene: Scene, size: tuple[int, int]) -> Iterator[Progress]:
-    return _find(WHITTED)[0](scene, size)
+def job_kind(pipeline) -> JobKind:
+    """The panel's entry for a registry pipeline: its job, picklable by name for built-ins."""
+    from functools import partial
 
+    from shadelab.pipelines import run_job
 
-def run_pathtrace(scene: Scene, size: tuple[int, int], seed: int = 1) -> Iterator[Progress]:
-    """The path tracer at the scene's samples per pixel (the panel sets them)."""
-    return _find(PATHTRACE)[0](scene, size, max(scene.raytrace.spp, 1), seed)
-
-
-def run_radiosity(scene: Scene, size: tuple[int, int]) -> Iterator[Progress]:
-    """Radiosity with ray-cast form factors: the GPU hemicube would need a GL context of its
-    own in the worker (the viewer's context belongs to the UI thread)."""
-    method = "raycast" if scene.radiosity.form_factors == "hemicube" else None
-    return _find(RADIOSITY)[0](scene, size, form_factors=method)
+    make = partial(run_job, pipeline.name) if _pickles(pipeline) else \
+        (lambda scene, size, p=pipeline: p.job(scene, size))
+    return JobKind(pipeline.job_label, make, "", pipeline.compare_shading, pipeline.name,
+                   bool(getattr(pipeline, "samples_setting", False)))
 
 
 def available_jobs() -> list[JobKind]:
-    """The offline renderers, each with a factory or the reason it is missing."""
-    kinds = [JobKind("Reference raster (numpy)", iter_reference_raster)]
-    for label, spec, run in (("Whitted ray tracer", WHITTED, run_whitted),
-                             ("Path tracer (reference GI)", PATHTRACE, run_pathtrace),
-                             ("Radiosity", RADIOSITY, run_radiosity)):
-        fn, reason = _find(spec)
-        kinds.append(JobKind(label, run if fn is not None else None, reason,
-                             "gouraud" if label == "Radiosity" else "phong"))
-    return kinds
+    """The offline renderers of :mod:`shadelab.pipelines` that offer a job, in panel order
+    (a pipeline registered later, e.g. by a test, is listed too)."""
+    from shadelab import pipelines
+
+    return [job_kind(p) for p in pipelines.job_pipelines()]
+
+
+def find_job(name: str) -> JobKind | None:
+    """The job of pipeline ``name``, or of the first label starting with ``name`` (--job)."""
+    kinds = available_jobs()
+    for kind in kinds:
+        if kind.pipeline == name:
+            return kind
+    for kind in kinds:
+        if name.strip() and kind.label.lower().startswith(name.lower()):
+            return kind
+    return None
 
 
 def difference(a: np.ndarray, b: np.ndarray) -> dict:

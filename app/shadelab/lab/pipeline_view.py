@@ -8,12 +8,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-PIPELINES = ("gouraud", "phong", "painter", "radiosity", "raytrace", "pathtrace")
-LABELS = {"gouraud": "z-buffer + Gouraud", "phong": "z-buffer + Phong",
-          "painter": "list priority + Phong", "radiosity": "radiosity + Gouraud",
-          "raytrace": "ray tracing (Whitted)", "pathtrace": "path tracing (reference)"}
-RASTER = {"gouraud": ("gouraud", "zbuffer"), "phong": ("phong", "zbuffer"),
-          "painter": ("phong", "painter")}
+from shadelab import pipelines as _registry
+
+#: The viewer's Pipeline selector: the registry's pipelines with a ``viewport`` place.
+PIPELINES = _registry.viewport_names()
+LABELS = {name: _registry.get(name).label for name in PIPELINES}
+#: The raster ones: (shading, visibility) they write into the scene.
+RASTER = {name: _registry.get(name).raster for name in PIPELINES
+          if _registry.get(name).raster is not None}
+#: The offline ones: the worker's job factory ``f(scene, size)`` (picklable by name).
+OFFLINE_NAMES = tuple(name for name in PIPELINES if name not in RASTER)
 
 
 @dataclass

@@ -149,30 +149,22 @@ def load_case(case: GalleryCase):
 
 def render_case(case: GalleryCase, size: tuple[int, int]) -> tuple[np.ndarray, float]:
     """The case's image (H, W, 3) float32 linear and the exposure to write it with."""
+    from shadelab import pipelines
+
     scene = load_case(case)
     kind, _, variant = case.method.partition(":")
+    options: dict = {}
     if kind == "raster":
-        from shadelab.raster.offscreen import render_image
-
-        image = render_image(scene, size, variant or None)
-    elif kind == "raytrace":
-        from shadelab.raytrace.whitted import render_raytraced
-
-        image = render_raytraced(scene, size)
+        options = {"shading": variant or None}
     elif kind == "pathtrace":
-        from shadelab.raytrace.pathtrace import iter_pathtrace
-
-        *_, last = iter_pathtrace(scene, size, int(variant or 16))
-        image = last.image
+        options = {"spp": int(variant or 16)}
     elif kind == "radiosity":
-        image = _render_radiosity(scene, size, adaptive=variant != "uniform")
-    else:
-        raise ValueError(f"gallery case {case.name}: unknown method {case.method}")
+        options = {"adaptive": variant != "uniform", "gpu": True}
+    try:
+        pipeline = pipelines.get(kind)
+    except Exception:
+        raise ValueError(f"gallery case {case.name}: unknown method {case.method}") from None
+    *_, last = pipeline.run(scene, None if kind == "radiosity" else size, **options)
+    # radiosity: the CPU image of the solution (primary rays), as the gallery always drew it
+    image = pipeline.image(last, size, display="cpu")
     return np.asarray(image, dtype=np.float32), scene.render.exposure
-
-
-def _render_radiosity(scene, size: tuple[int, int], adaptive: bool = True) -> np.ndarray:
-    from shadelab.radiosity.solution import solve_scene
-    from shadelab.raster.hemicube import Hemicube  # the GPU backend of hemicube form factors
-
-    return solve_scene(scene, adaptive=adaptive, hemicube=Hemicube).image(size)

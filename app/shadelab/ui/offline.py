@@ -9,6 +9,7 @@ from imgui_bundle import imgui
 
 from shadelab.lab.jobs import available_jobs, difference
 from shadelab.lab.state import AppState
+from shadelab.pipelines import viewport_names
 from shadelab.scene.preset import clone_scene
 from shadelab.shading.conventions import heat_map, to_srgb8
 from shadelab.ui import panels
@@ -56,7 +57,7 @@ def start_job(state: AppState, index: int) -> None:
         state.error = f"{kind.label}: not available ({kind.reason})"
         return
     scene = clone_scene(state.scene)
-    if kind.label.startswith("Path"):
+    if kind.samples:
         scene.raytrace.spp = state.job_spp
     size = _job_size(state)
     # the raster view to compare with: drawn by the GL side before the panels' next frame
@@ -71,8 +72,14 @@ def start_job(state: AppState, index: int) -> None:
 
 
 def start_job_by_label(state: AppState, label: str) -> None:
-    for i, kind in enumerate(kinds(state)):
-        if kind.label.lower().startswith(label.lower()):
+    """--job and the Studies panel: a pipeline's name, else a prefix of its label."""
+    options = kinds(state)
+    for i, kind in enumerate(options):
+        if kind.pipeline and kind.pipeline == label:
+            start_job(state, i)
+            return
+    for i, kind in enumerate(options):
+        if label.strip() and kind.label.lower().startswith(label.lower()):
             start_job(state, i)
             return
     state.error = f"--job '{label}': expected one of " + ", ".join(k.label for k in kinds(state))
@@ -193,9 +200,6 @@ def _rgb(v) -> str:
     return "(" + ", ".join(f"{float(c):.3g}" for c in np.asarray(v).reshape(-1)[:3]) + ")"
 
 
-VIEWPORT_PIPELINE = {"Whitted": "raytrace", "Path": "pathtrace", "Radiosity": "radiosity"}
-
-
 def work_done(latest) -> str:
     """Progress in the job's own units: rays traced, paths sampled, patches and shots."""
     if latest is None:
@@ -228,7 +232,7 @@ def draw_offline_panel(state: AppState) -> bool:
     index = SIZES.index(state.job_size) if state.job_size in SIZES else SIZES.index(256)
     _, index = imgui.combo("Height (px)", index, [str(s) for s in SIZES])
     state.job_size = SIZES[index]
-    if kind.label.startswith("Path"):
+    if kind.samples:
         index = SAMPLES.index(state.job_spp) if state.job_spp in SAMPLES else 0
         _, index = imgui.combo("Samples / pixel", index, [str(n) for n in SAMPLES])
         state.job_spp = SAMPLES[index]
@@ -250,7 +254,7 @@ def draw_offline_panel(state: AppState) -> bool:
         imgui.progress_bar(fraction, imgui.ImVec2(-1, 0),
                            f"{job.name}: {word} {work_done(latest)}")
         imgui.text_wrapped(f"elapsed {job.elapsed:.1f} s   {latest.message if latest else ''}")
-        target = VIEWPORT_PIPELINE.get(kind.label.split(" ")[0])
+        target = kind.pipeline if kind.pipeline in viewport_names() else None
         if target is not None and imgui.small_button("Show in viewport"):
             from shadelab.ui.pipelines import set_pipeline
 
@@ -266,9 +270,10 @@ def draw_offline_panel(state: AppState) -> bool:
         state.error = f"raster view to compare with: {state.gpu.errors.pop('job_raster')}"
     width = (imgui.get_content_region_avail().x - 16) / 3
     if state.gpu.texture("job_result") is not None and width > 8:
+        ray_tree = kind.pipeline == "raytrace"  # the Whitted tracer keeps a ray tree per pixel
         clicked = _show(state, "job_result", "offline (click: ray tree)"
-                        if kind.label.startswith("Whitted") else "offline", width)
-        if clicked is not None and kind.label.startswith("Whitted") and not job.running:
+                        if ray_tree else "offline", width)
+        if clicked is not None and ray_tree and not job.running:
             trace_tree(state, clicked)
         imgui.same_line()
         _show(state, "job_raster", f"raster ({kind.raster_shading})", width)

@@ -24,6 +24,7 @@ from imgui_bundle import imgui
 from shadelab.lab import pipeline_jobs
 from shadelab.lab.pipeline_view import (  # noqa: F401  (the viewer reads them here too)
     LABELS,
+    OFFLINE_NAMES,
     PIPELINES,
     RASTER,
     PipelineView,
@@ -35,9 +36,7 @@ from shadelab.lab.pipeline_view import (  # noqa: F401  (the viewer reads them h
 from shadelab.lab.state import AppState
 from shadelab.scene.preset import clone_scene
 
-OFFLINE = {"raytrace": pipeline_jobs.pipeline_raytrace,
-           "pathtrace": pipeline_jobs.pipeline_pathtrace,
-           "radiosity": pipeline_jobs.pipeline_radiosity}
+OFFLINE = {name: pipeline_jobs.pipeline_job(name) for name in OFFLINE_NAMES}
 RAY_COLORS = {"primary": 0xFFFFFFFF, "reflected": 0xFF30D0FF, "refracted": 0xFFFFB040,
               "shadow": 0xFF40FF40, "blocked": 0xFF4040FF}   # ImGui ABGR
 SHOOTER_COLOR = (1.0, 0.9, 0.1)

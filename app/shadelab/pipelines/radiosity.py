@@ -1,0 +1,221 @@
+"""``radiosity``: patches, form factors, a solver; the solution's Gouraud-shaded triangles.
+
+One driver, two ways to watch it:
+
+* :meth:`RadiosityPipeline.run` (``shadelab.render``, ``shadelab radiosity``, the Offline
+  panel): :func:`shadelab.radiosity.solution.iter_radiosity`, adaptive meshing by default; the
+  last step's ``stats["solution"]`` is the :class:`RadiositySolution`, drawn by
+  :meth:`RadiosityPipeline.image` (the GL program, or CPU rays with ``display="cpu"``).
+* :meth:`RadiosityPipeline.viewport_job` (the viewer): uniform patches shot by shot
+  (progressive refinement), the display triangles (``stats["soup"]``) after each chunk of shots
+  with the patch that shot last; the GPU draws them under the live camera. Patches and
+  form-factor rows stay in the worker between jobs, so a material or emission edit re-solves
+  without re-meshing (``stats["form_factors_reused"]``). Both use the same patches, form
+  factors and solvers (:mod:`shadelab.radiosity`).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Iterator
+
+import numpy as np
+
+from shadelab.pipelines.base import TRIANGLES, BasePipeline
+from shadelab.pipelines.registry import register
+from shadelab.progress import Progress
+from shadelab.scene.model import Scene
+
+RADIOSITY_CHUNK_S = 0.05     # seconds of shooting between two viewer updates
+_RADIOSITY_CACHE: dict = {}  # worker process: geometry key -> (patches, form factors, token)
+
+
+class RadiosityPipeline(BasePipeline):
+    name = "radiosity"
+    label = "radiosity + Gouraud"
+    output = TRIANGLES
+    options = ("patches", "form_factors", "solver", "adaptive", "meshing", "gpu", "display")
+    default_size = (512, 512)
+    viewport = 4
+    job_label = "Radiosity"
+    job_order = 4
+    compare_shading = "gouraud"
+    unit = "patches"
+
+    def check(self, scene: Scene, label: str = "") -> None:
+        from shadelab.radiosity.solution import check_scene
+
+        check_scene(scene)
+
+    def run(self, scene: Scene, size: tuple[int, int] | None = None,
+            patches: int | None = None, form_factors: str | None = None,
+            solver: str | None = None, adaptive: bool = True, meshing: str = "uniform",
+            gpu: bool = False, display: str = "gl") -> Iterator[Progress]:
+        """``gpu``: hemicube form factors on the GL hemicube; ``size``: CPU images on the way
+        (None: none, as the CLI and shadelab.render do; they draw the result with GL)."""
+        from shadelab.radiosity.solution import iter_radiosity, precheck
+
+        if patches is not None:
+            from shadelab.radiosity.patches import check_count
+
+            check_count(patches)
+        precheck(scene, patches or scene.radiosity.patches,
+                 form_factors or scene.radiosity.form_factors)
+        hemicube = None
+        if gpu:
+            from shadelab.raster.hemicube import Hemicube  # GL only when asked for
+
+            hemicube = Hemicube
+        return iter_radiosity(scene, size, patches, form_factors, solver, adaptive=adaptive,
+                              hemicube=hemicube, meshing=meshing)
+
+    def image(self, last: Progress, size: tuple[int, int], display: str = "gl",
+              **_) -> np.ndarray:
+        solution = last.stats["solution"]
+        if display == "cpu":
+            return solution.image(size)
+        from shadelab.raster.radiosity_image import render_solution  # GL only once solved
+
+        return render_solution(solution, size)
+
+    def info(self, last: Progress, options: dict) -> dict:
+        return {k: v for k, v in last.stats["solution"].stats.items() if k != "history"}
+
+    def job(self, scene: Scene, size: tuple[int, int]) -> Iterator[Progress]:
+        """Ray-cast form factors: the GPU hemicube would need a GL context of its own in the
+        worker (the viewer's context belongs to the UI thread)."""
+        method = "raycast" if scene.radiosity.form_factors == "hemicube" else None
+        from shadelab.radiosity.solution import iter_radiosity
+
+        return iter_radiosity(scene, size, form_factors=method)
+
+    def viewport_job(self, scene: Scene, size=None, step_shots: int = 0) -> Iterator[Progress]:
+        return pipeline_radiosity(scene, size, step_shots)
+
+
+register(RadiosityPipeline())
+
+
+def radiosity_key(scene: Scene) -> str:
+    """What the patches and form factors depend on: geometry and meshing, not materials."""
+    s = scene.radiosity
+    objects = [(o.shape, o.material, o.path, o.radius, o.minor_radius, o.height, o.extents,
+                o.size, tuple(map(tuple, o.vertices)), o.subdivisions, o.sections, o.segments,
+                o.translate, o.rotate, o.scale) for o in scene.objects]
+    return repr((objects, scene.base_dir, s.patches, ff_method(scene), s.hemicube_resolution))
+
+
+def ff_method(scene: Scene) -> str:
+    """The worker has no GL context: the GPU hemicube becomes ray-cast form factors there."""
+    method = scene.radiosity.form_factors
+    return "raycast" if method == "hemicube" else method
+
+
+def soup(vertices_faces_colors: list) -> np.ndarray:
+    """(3F, 6) float32 position and radiance per corner (the viewport's triangle format)."""
+    parts = [np.concatenate([np.asarray(v)[f].reshape(-1, 3), np.asarray(c)[f].reshape(-1, 3)],
+                            axis=1) for v, f, c in vertices_faces_colors if len(f)]
+    if not parts:
+        return np.zeros((0, 6), np.float32)
+    return np.ascontiguousarray(np.concatenate(parts), dtype=np.float32)
+
+
+def _reflectance(scene: Scene, patches) -> tuple[np.ndarray, np.ndarray]:
+    """rho = kd Od and Le per patch from the scene's current materials."""
+    rho, emission = np.zeros((len(patches), 3)), np.zeros((len(patches), 3))
+    for index, surface in enumerate(patches.surfaces):
+        material = scene.materials[surface.material]
+        mask = patches.surface == index
+        rho[mask] = material.kd * np.asarray(material.Od, float)
+        emission[mask] = material.emission
+    return rho, emission
+
+
+def pipeline_radiosity(scene: Scene, size: tuple[int, int] | None = None,
+                       step_shots: int = 0) -> Iterator[Progress]:
+    """Radiosity shot by shot; ``stats``: display ``soup``, ``shooter`` (4, 3) corners,
+    ``history``, ``patches``, ``form_factors_reused`` and the form factors' ``ff_token``.
+    ``step_shots`` > 0 yields after every that many shots (the step button)."""
+    from shadelab.radiosity import display
+    from shadelab.radiosity.formfactors import FormFactors
+    from shadelab.radiosity.patches import check_count, uniform_patches
+    from shadelab.radiosity.solution import check_scene
+    from shadelab.radiosity.solvers import check_solvable, run_solver
+
+    settings = scene.radiosity
+    check_count(settings.patches, "radiosity.patches")
+    check_scene(scene)
+    start = time.perf_counter()
+    key = radiosity_key(scene)
+    cached = _RADIOSITY_CACHE.get(key)
+    reused = cached is not None
+    if cached is None:
+        yield Progress(None, 0.0, "meshing", {"unit": "patches"})
+        patches = uniform_patches(scene, settings.patches)
+        ff = FormFactors(patches, ff_method(scene), settings.hemicube_resolution)
+        cached = (patches, ff, f"ff-{time.time_ns()}")
+        _RADIOSITY_CACHE.clear()  # one geometry at a time: the rows can be large
+        _RADIOSITY_CACHE[key] = cached
+    patches, ff, token = cached
+    rho, emission = _reflectance(scene, patches)
+    E = math.pi * emission
+    n = len(patches)
+    base = {"patches": n, "form_factors": ff.method, "solver": settings.solver,
+            "form_factors_reused": reused, "ff_token": token, "unit": "patches"}
+    shooter = [-1]
+
+    def row(i: int) -> np.ndarray:
+        shooter[0] = i
+        return ff.row(i)
+
+    if settings.solver == "progressive":
+        steps = run_solver("progressive", None, rho, E, settings.iterations, settings.tolerance,
+                           row=row, areas=patches.areas)
+    else:
+        yield Progress(None, 0.05, f"form factors ({n} patches)", dict(base))
+        F = ff.matrix()
+        check_solvable(F, rho)
+        steps = run_solver(settings.solver, F, rho, E, settings.iterations, settings.tolerance,
+                           areas=patches.areas)
+    history = {"iteration": [], "residual": [], "unshot": []}
+    last, last_yield, since = None, 0.0, 0
+    for last in steps:
+        history["iteration"].append(last.iteration)
+        history["residual"].append(float(last.residual))
+        history["unshot"].append(float(last.unshot))
+        since += 1
+        now = time.perf_counter()
+        if step_shots > 0 and since < step_shots:
+            continue
+        if step_shots <= 0 and now - last_yield < RADIOSITY_CHUNK_S and last.iteration > 1:
+            continue
+        since, last_yield = 0, now
+        yield _radiosity_progress(patches, rho, last, shooter[0], history, base, start,
+                                  display, ff, final=False, settings=settings)
+    if last is None:
+        return
+    yield _radiosity_progress(patches, rho, last, shooter[0], history, base, start, display,
+                              ff, final=True, settings=settings)
+
+
+def _radiosity_progress(patches, rho, step, shooter, history, base, start, display, ff,
+                        final: bool, settings) -> Progress:
+    B = step.display_B(rho)
+    meshes = display.display_meshes(patches, B / math.pi, True)
+    value = step.unshot if np.isnan(step.residual) else step.residual
+    tol = max(settings.tolerance, 1e-12)
+    fraction = 1.0 if final or not value > tol else \
+        min(0.99, math.log(max(value, 1e-300)) / math.log(tol)) if value < 1.0 else 0.0
+    what = (f"shot {step.iteration}, unshot {step.unshot:.2e}" if np.isnan(step.residual)
+            else f"iteration {step.iteration}, residual {step.residual:.2e}")
+    stats = dict(base, soup=soup(meshes), history={k: list(v) for k, v in history.items()},
+                 shots=step.iteration, elapsed_s=time.perf_counter() - start,
+                 rows=len(ff._rows), done=final)
+    if shooter >= 0:
+        stats["shooter"] = np.asarray(patches.polygons[shooter], np.float32)
+        stats["shooter_index"] = int(shooter)
+    return Progress(None, max(fraction, 0.0), ("done: " if final else "") + what
+                    + f" ({len(patches)} patches)", stats)
+
+
