@@ -16,7 +16,7 @@ def draw_compare(viewer, size: tuple[int, int]) -> None:
     state, vp = viewer.state, viewer.viewport
     scene = state.scene
     # Four quadrants; with the heat map, the map takes 70% of the width at full height.
-    if state.diff_enabled:
+    if state.view.diff_enabled:
         half = (max(int(size[0] * 0.7), 8), max(size[1], 8))
     else:
         half = (max(size[0] // 2, 8), max(size[1] // 2, 8))
@@ -26,17 +26,17 @@ def draw_compare(viewer, size: tuple[int, int]) -> None:
     else:
         panes = [vp.draw_scene(f"compare{i}", scene, half, shading, specular, viewer.samples())
                  for i, (shading, specular) in enumerate(COMPARE_VIEWS)]
-    if state.diff_enabled:
-        a, b = state.diff_pair
+    if state.view.diff_enabled:
+        a, b = state.view.diff_pair
         diff = vp.pane("diff", half)
-        vp.present(diff, exposure, panes[a], panes[b], state.diff_scale)
+        vp.present(diff, exposure, panes[a], panes[b], state.view.diff_scale)
         origin = imgui.get_cursor_screen_pos()
         texture = diff.display
         viewer._image_with_input(texture, half)
         draw = imgui.get_window_draw_list()
         draw.add_text(imgui.ImVec2(origin.x + 6, origin.y + 4), 0xFFFFFFFF,
                       f"|{COMPARE_LABELS[a]} - {COMPARE_LABELS[b]}| x exposure, "
-                      f"full red = {state.diff_scale:.3g}")
+                      f"full red = {state.view.diff_scale:.3g}")
         imgui.same_line()
         imgui.begin_group()
         thumb_w = max(size[0] - half[0] - 12, 8)
@@ -51,7 +51,7 @@ def draw_compare(viewer, size: tuple[int, int]) -> None:
         return
     origin = imgui.get_cursor_screen_pos()
     for pane in panes:
-        vp.present(pane, exposure, tonemap=state.tonemap, clipping=state.show_clipping)
+        vp.present(pane, exposure, tonemap=state.view.tonemap, clipping=state.view.show_clipping)
     draw = imgui.get_window_draw_list()
     for i, pane in enumerate(panes):
         x = origin.x + (i % 2) * half[0]

@@ -1,7 +1,7 @@
 """The viewer's panels: each ``draw_<x>_panel(state) -> bool`` (True when it edited the scene).
 
 Panels only read and write :class:`shadelab.lab.state.AppState`; GL work is asked for through it
-(``state.probe_requested``, ``state.screenshot_requested``) and done by :mod:`shadelab.ui.app`.
+(``state.probe.requested``, ``state.screenshot_requested``) and done by :mod:`shadelab.ui.app`.
 """
 
 from __future__ import annotations
@@ -127,11 +127,11 @@ def draw_lesson_row(state: AppState) -> None:
     PageUp / PageDown do the same); (none) ends it and keeps the scene."""
     from shadelab.lab import lesson
 
-    run = state.lesson
+    run = state.walk.lesson
     current = "" if run is None else Path(run.lesson.path).stem
     if imgui.begin_combo("Lesson", current or "(none)"):
         if imgui.selectable("(none)", run is None)[0]:
-            state.lesson = None                    # the scene stays as it is
+            state.walk.lesson = None                    # the scene stays as it is
         for name in lesson.list_lessons():
             if imgui.selectable(name, name == current)[0]:
                 state.request_open(str(lesson.lessons_dir() / f"{name}.toml"))
@@ -208,11 +208,12 @@ def draw_render_panel(state: AppState) -> bool:
             scene.render.specular, edited = model, True
     edited |= _edit_fields(scene.render, [("exposure", field_slider(RenderSettings))])
     edited |= _edit_fields(scene, [("Ia", _intensity_color)])
-    _, state.show_wireframe = imgui.checkbox("Wireframe (W)", state.show_wireframe)
+    _, state.view.show_wireframe = imgui.checkbox("Wireframe (W)", state.view.show_wireframe)
     imgui.same_line()
-    _, state.show_normals = imgui.checkbox("Normals (N)", state.show_normals)
-    if state.show_normals:
-        _, state.normal_length = _slider("glyph length", state.normal_length, 0.005, 0.3, True)
+    _, state.view.show_normals = imgui.checkbox("Normals (N)", state.view.show_normals)
+    if state.view.show_normals:
+        _, state.view.normal_length = _slider("glyph length", state.view.normal_length,
+                                              0.005, 0.3, True)
     changed, mode = _combo("normals (all)", "", ("",) + NORMALS_MODES)
     if changed and mode:
         for obj in scene.objects:
@@ -262,7 +263,7 @@ def _draw_attenuation_plot(state: AppState, index: int, light: Light) -> None:
         if light.attenuation == "inverse_square":
             implot.setup_axis_scale(implot.ImAxis_.y1, implot.Scale_.log10)
         implot.plot_line("f_att", d, f)
-        probe = state.probe
+        probe = state.probe.result
         active = [i for i, other in enumerate(state.scene.lights) if other.enabled]
         if probe is not None and index in active \
                 and active.index(index) < len(probe.terms.lights):
@@ -427,7 +428,7 @@ def draw_equation_panel(state: AppState) -> bool:
     imgui.text_wrapped("f_att = min(1 / (c1 + c2 d + c3 d^2), 1);  "
                        + ("H = (L + V) / |L + V|" if blinn else "R = 2 N (N.L) - L"))
     imgui.text_wrapped(f"Ia = {_rgb(scene.Ia)}   shading: {SHADING_LABELS[scene.render.shading]}")
-    result = state.probe
+    result = state.probe.result
     if result is None:
         imgui.separator()
         imgui.text_wrapped("Click a pixel in the viewport to probe it: its N, L_i, V and "
@@ -509,14 +510,15 @@ def draw_equation_panel(state: AppState) -> bool:
 
 def draw_compare_panel(state: AppState) -> bool:
     """2x2 compare mode and the difference heat map between any two views."""
-    _, state.compare = imgui.checkbox("Compare 2x2 (C)", state.compare)
-    if not state.compare:
+    _, state.view.compare = imgui.checkbox("Compare 2x2 (C)", state.view.compare)
+    if not state.view.compare:
         return False
-    _, state.diff_enabled = imgui.checkbox("Difference heat map", state.diff_enabled)
-    a, b = state.diff_pair
+    _, state.view.diff_enabled = imgui.checkbox("Difference heat map", state.view.diff_enabled)
+    a, b = state.view.diff_pair
     _, a = imgui.combo("A", a, list(COMPARE_LABELS))
     _, b = imgui.combo("B", b, list(COMPARE_LABELS))
-    state.diff_pair = (a, b)
-    _, state.diff_scale = _slider("full scale |A-B|", state.diff_scale, 1e-4, 1.0, True, "%.4g")
+    state.view.diff_pair = (a, b)
+    _, state.view.diff_scale = _slider("full scale |A-B|", state.view.diff_scale, 1e-4, 1.0,
+                                       True, "%.4g")
     return False
 
