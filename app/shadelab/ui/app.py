@@ -262,12 +262,15 @@ class Viewer:
         return None
 
     def frame_key(self, size: tuple[int, int]) -> tuple:
-        """Everything the viewport image depends on; an unchanged key reuses the last image."""
+        """Everything the viewport image depends on; an unchanged key reuses the last image.
+
+        The scene counts by its edit counter (``Scene.version``: any change in it, announced by
+        ``mark_edited`` or not) and by which scene it is (``scene_version``: loads, undo)."""
         s, v = self.state, self.state.view
-        return (repr(s.scene), size, v.compare, v.diff_enabled, v.diff_pair, v.diff_scale,
-                v.show_wireframe, v.show_normals, v.normal_length, s.probe.version,
-                s.offline.overlay_version, s.offline.show_radiosity, v.tonemap, v.show_clipping,
-                presenter.line_px(s), v.antialias, v.msaa)
+        return (id(s.scene), s.scene_version, s.scene.version, size, v.compare, v.diff_enabled,
+                v.diff_pair, v.diff_scale, v.show_wireframe, v.show_normals, v.normal_length,
+                s.probe.version, s.offline.overlay_version, s.offline.show_radiosity, v.tonemap,
+                v.show_clipping, presenter.line_px(s), v.antialias, v.msaa)
 
     def unchanged(self, size: tuple[int, int]) -> bool:
         """True when the last image is still right (idle frames only redraw the GUI)."""
