@@ -148,6 +148,11 @@ def draw_help_overlay(state: AppState) -> None:
 
 @dataclass
 class Viewer:
+    """The viewer window: the panels' AppState and the GL side (viewport, GPU requests).
+
+    Implements :class:`shadelab.ui.viewport_host.ViewportHost`, what the viewport layouts
+    (compare grid, presenter, pipelines) may ask of it."""
+
     state: AppState
     options: ViewerOptions
     viewport: object = None            # shadelab.ui.viewport.Viewport, made in post_init
@@ -227,7 +232,7 @@ class Viewer:
             imgui.set_cursor_pos(imgui.ImVec2(12, 40))
             imgui.text_colored(panels.ERROR_COLOR, f"Error: {state.error}")
 
-    def _image_with_input(self, texture, size: tuple[int, int]) -> tuple[float, float] | None:
+    def image_with_input(self, texture, size: tuple[int, int]) -> tuple[float, float] | None:
         """Show the texture; handle orbit/pan/zoom; return the clicked pixel, if any."""
         state = self.state
         origin = imgui.get_cursor_screen_pos()
@@ -261,6 +266,9 @@ class Viewer:
             return mouse.x - origin.x, mouse.y - origin.y
         return None
 
+    # Remaining for the pipelines merge: ui/pipeline_viewport.py still calls the old name.
+    _image_with_input = image_with_input
+
     def frame_key(self, size: tuple[int, int]) -> tuple:
         """Everything the viewport image depends on; an unchanged key reuses the last image.
 
@@ -288,7 +296,7 @@ class Viewer:
             return
         display_size, size = size, self.render_size(size)
         if "main" in vp.panes and self.unchanged(size):
-            self._handle_click(self._image_with_input(vp.panes["main"].display, display_size),
+            self._handle_click(self.image_with_input(vp.panes["main"].display, display_size),
                                display_size)
             return
         # --- PASS 1-2: the scene into the float target (the Renderer's passes), or the solved
@@ -324,7 +332,7 @@ class Viewer:
         if state.screenshot_requested:
             write_viewport_screenshot(state, vp, state.screenshot_requested)
             state.screenshot_requested = ""
-        self._handle_click(self._image_with_input(texture, display_size), display_size)
+        self._handle_click(self.image_with_input(texture, display_size), display_size)
 
     def samples(self) -> int:
         """MSAA samples of the scene pass: the Display panel's choice, within the GL's limit."""

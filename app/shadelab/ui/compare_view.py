@@ -8,9 +8,10 @@ from imgui_bundle import imgui
 
 from shadelab.lab import camera_control
 from shadelab.lab.state import COMPARE_LABELS, COMPARE_VIEWS, AppState
+from shadelab.ui.viewport_host import ViewportHost
 
 
-def draw_compare(viewer, size: tuple[int, int]) -> None:
+def draw_compare(viewer: ViewportHost, size: tuple[int, int]) -> None:
     """The 2x2 grid of shading modes under one camera, or the difference heat map of two of
     them with both as thumbnails (the D key)."""
     state, vp = viewer.state, viewer.viewport
@@ -32,7 +33,7 @@ def draw_compare(viewer, size: tuple[int, int]) -> None:
         vp.present(diff, exposure, panes[a], panes[b], state.view.diff_scale)
         origin = imgui.get_cursor_screen_pos()
         texture = diff.display
-        viewer._image_with_input(texture, half)
+        viewer.image_with_input(texture, half)
         draw = imgui.get_window_draw_list()
         draw.add_text(imgui.ImVec2(origin.x + 6, origin.y + 4), 0xFFFFFFFF,
                       f"|{COMPARE_LABELS[a]} - {COMPARE_LABELS[b]}| x exposure, "

@@ -12,6 +12,7 @@ from imgui_bundle import hello_imgui, imgui
 
 from shadelab.lab.state import AppState
 from shadelab.ui.layout import same_line_if_fits
+from shadelab.ui.viewport_host import ViewportHost
 
 PRESENTER_SCALE = 1.8          # font scale of presenter mode (ui/app.py applies it)
 LINE_PX = 1.5                  # overlay line width at font scale 1, pixels
@@ -116,7 +117,7 @@ def apply_panel_visibility(state: AppState) -> None:
         _hidden_labels = []
 
 
-def draw_presenter_viewport(viewer) -> None:
+def draw_presenter_viewport(viewer: ViewportHost) -> None:
     """With the panels hidden: the viewport over the whole window."""
     state = viewer.state
     if not state.view.hide_panels:
@@ -367,7 +368,7 @@ def draw_antialias_choice(state: AppState) -> None:
 # ---------------------------------------------------------------- per frame
 
 
-def end_frame(viewer) -> None:
+def end_frame(viewer: ViewportHost) -> None:
     """Fullscreen, panel visibility, dialogs, drops, stale overlays, panel focus."""
     from shadelab.ui import dialogs
 
