@@ -2,17 +2,17 @@
 
 :class:`shadelab.ui.app.Viewer` implements it; :mod:`shadelab.ui.compare_view` and
 :mod:`shadelab.ui.presenter` take a ``ViewportHost``, never the Viewer itself, and call
-nothing private of it. Types only: no imgui, no GL at import time.
+nothing private of it. Types only: no imgui and no GL module, not even for type checking
+(only the GL side names the GL classes: ``viewport`` is a :class:`shadelab.ui.viewport.Viewport`,
+``gpu`` a :class:`shadelab.ui.gpu_side.GpuSide`).
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 if TYPE_CHECKING:
     from shadelab.lab.state import AppState
-    from shadelab.ui.gpu_side import GpuSide
-    from shadelab.ui.viewport import Viewport
 
 
 class ViewportHost(Protocol):
@@ -23,12 +23,12 @@ class ViewportHost(Protocol):
         """The panels' state (read and written by the layouts too)."""
 
     @property
-    def viewport(self) -> Viewport:
-        """The GL side's panes: draw the scene into them, present them."""
+    def viewport(self) -> Any:
+        """The GL side's panes (a Viewport): draw the scene into them, present them."""
 
     @property
-    def gpu(self) -> GpuSide:
-        """Serves the panels' GPU requests (``state.gpu``)."""
+    def gpu(self) -> Any:
+        """The GL side serving the panels' GPU requests (``state.gpu``; a GpuSide)."""
 
     def image_with_input(self, texture, size: tuple[int, int]) -> tuple[float, float] | None:
         """Show ``texture`` at ``size`` with the viewport's mouse handling (orbit, pan, zoom,
