@@ -440,7 +440,7 @@ def scenario_dialogs(ctx, state, out: dict) -> None:
     import trimesh
 
     from shadelab.scene.preset import load_preset
-    from shadelab.ui import dialogs, panels
+    from shadelab.ui import dialogs, lights_panel
 
     mesh_path = Path(OUT_DIR) / "tet.obj"
     trimesh.creation.icosphere(1).export(mesh_path)
@@ -477,16 +477,16 @@ def scenario_dialogs(ctx, state, out: dict) -> None:
     out["dropped"] = state.scene.name
     # an exception inside an open ImGui scope (a tree node of the Lights panel)
 
-    original = panels._light_rows
+    original = lights_panel._light_rows
 
     def broken(light, span):
         raise UnicodeDecodeError("utf-8", b"\xff", 0, 1, "boom")
 
-    panels._light_rows = broken
+    lights_panel._light_rows = broken
     ctx.window_focus("//Lights")
     ctx.yield_(5)
     out["panel_error"] = state.error
-    panels._light_rows = original
+    lights_panel._light_rows = original
     frame = state.frame
     ctx.yield_(5)
     out["frames_after_error"] = state.frame - frame

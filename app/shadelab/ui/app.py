@@ -9,7 +9,6 @@ snapshots, autosave, window title).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Callable
 
 import numpy as np
@@ -28,13 +27,18 @@ from shadelab.lab.state import (
 )
 from shadelab.ui import (
     compare_view,
+    equation_panel,
     gizmos,
     layout,
+    lights_panel,
+    materials_panel,
+    objects_panel,
     panels,
     pipeline_viewport,
     pipelines,
     presenter,
     radiosity_view,
+    scene_panel,
 )
 from shadelab.ui.followups import FollowUps, ViewerOptions, write_window_screenshot
 from shadelab.ui.frame import guarded
@@ -74,17 +78,8 @@ def _toggle_blinn(state: AppState) -> None:
     state.mark_edited()
 
 
-def _screenshot(state: AppState) -> None:
-    name = state.scene.name or "scene"
-    folder = Path(state.screenshot_dir)
-    index = 1
-    while (folder / f"shadelab-{name}-{index:03d}.png").exists():
-        index += 1
-    state.screenshot_requested = str(folder / f"shadelab-{name}-{index:03d}.png")
-
-
 def _save(state: AppState) -> None:
-    panels.save_here(state)
+    scene_panel.save_here(state)
 
 
 K = imgui.Key
@@ -102,7 +97,7 @@ SHORTCUTS = (
     (K.c, "C", "compare 2x2", _toggle("compare")),
     (K.d, "D", "difference heat map (compare)", _toggle("diff_enabled")),
     (K.r, "R", "reset view", AppState.reset_view),
-    (K.s, "S", "screenshot of the viewport", _screenshot),
+    (K.s, "S", "screenshot of the viewport", scene_panel.screenshot),
     (K.f, "F", "presenter mode (large fonts)", _toggle("presenter")),
     (K.h, "H", "this help", _toggle("show_help")),
     (K.f1, "F1", "this help", _toggle("show_help")),
@@ -467,13 +462,13 @@ def _docking(viewer: Viewer) -> hello_imgui.DockingParams:
     ]
     p = viewer.panel
     params.dockable_windows = [
-        window("Scene", "LeftSpace", p(_scene_panel)),
-        window("Lights", "LeftSpace", p(panels.draw_lights_panel)),
-        window("Materials", "LeftSpace", p(panels.draw_materials_panel)),
-        window("Objects", "LeftSpace", p(panels.draw_objects_panel)),
+        window("Scene", "LeftSpace", p(scene_panel.draw_scene_panel)),
+        window("Lights", "LeftSpace", p(lights_panel.draw_lights_panel)),
+        window("Materials", "LeftSpace", p(materials_panel.draw_materials_panel)),
+        window("Objects", "LeftSpace", p(objects_panel.draw_objects_panel)),
         window("Viewport", "MainDockSpace",
                lambda: guarded(viewer.draw_viewport_window, "viewport", viewer.report_error)),
-        window("Equation & probe", "RightSpace", p(panels.draw_equation_panel)),
+        window("Equation & probe", "RightSpace", p(equation_panel.draw_equation_panel)),
         window("Studies", "RightSpace", p(draw_studies_panel)),
         window("Failure gallery", "RightSpace", p(draw_gallery_panel)),
         window("Offline render", "RightBottom", p(draw_offline_panel)),
@@ -487,29 +482,6 @@ def _docking(viewer: Viewer) -> hello_imgui.DockingParams:
     params.dockable_windows[0].focus_window_at_next_frame = True
     params.dockable_windows[5].focus_window_at_next_frame = True  # the right column's first tab
     return params
-
-
-def _scene_panel(state: AppState) -> bool:
-    panels.draw_file_panel(state)
-    imgui.separator()
-    edited = panels.draw_render_panel(state)
-    imgui.separator()
-    panels.draw_compare_panel(state)
-    _, state.view.presenter = imgui.checkbox("Presenter mode (F)", state.view.presenter)
-    imgui.same_line()
-    _, state.view.show_help = imgui.checkbox("Help (H)", state.view.show_help)
-    if imgui.button("Screenshot (S)"):
-        _screenshot(state)
-    imgui.same_line()
-    _, state.view.legend_in_screenshot = imgui.checkbox("with legend",
-                                                        state.view.legend_in_screenshot)
-    if imgui.button("Reset view (R)"):
-        state.reset_view()
-    _, state.view.render_scale = panels._slider("render scale", state.view.render_scale, 0.25, 1.0)
-    _, state.view.interactive_scale = panels._slider("while dragging", state.view.interactive_scale,
-                                                0.25, 1.0)
-    edited |= presenter.draw_display_panel(state)
-    return edited
 
 
 def runner_params(viewer: Viewer) -> hello_imgui.RunnerParams:

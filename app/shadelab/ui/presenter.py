@@ -189,7 +189,8 @@ def caption_text(state: AppState) -> str:
         return state.walk.lesson.caption()
     if not state.view.hide_panels:
         return ""
-    from shadelab.ui.panels import EQUATION, EQUATION_BLINN, SHADING_LABELS
+    from shadelab.ui.equation_panel import EQUATION, EQUATION_BLINN
+    from shadelab.ui.panels import SHADING_LABELS
 
     render = state.scene.render
     equation = EQUATION_BLINN if render.specular == "blinn" else EQUATION
