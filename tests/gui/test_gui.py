@@ -138,8 +138,8 @@ def _wait(ctx, until, frames: int = 600) -> bool:
 
 
 def _probe_at(ctx, state, pixel) -> None:
-    state.probe_pixel, state.probe, state.probe_requested = tuple(pixel), None, True
-    _wait(ctx, lambda: state.probe is not None and not state.probe_requested)
+    state.probe.pixel, state.probe.result, state.probe.requested = tuple(pixel), None, True
+    _wait(ctx, lambda: state.probe.result is not None and not state.probe.requested)
 
 
 def _gl_side():
@@ -150,14 +150,14 @@ def _gl_side():
 
 
 def _centre(state) -> tuple[int, int]:
-    w, h = state.viewport_size
+    w, h = state.view.viewport_size
     return w // 2, h // 2
 
 
 def scenario_kd_slider(ctx, state, out: dict) -> None:
     ctx.yield_(3)
     _probe_at(ctx, state, _centre(state))  # the back wall: Cornell white
-    out["gpu_before"] = state.probe.gpu.tolist()
+    out["gpu_before"] = state.probe.result.gpu.tolist()
     out["uploads_before"] = len(_gl_side().renderer._gpu)
     keys_before = [g.key for g in _gl_side().renderer._gpu.values()]
     ctx.set_ref("//Materials")
@@ -166,8 +166,8 @@ def scenario_kd_slider(ctx, state, out: dict) -> None:
     ctx.yield_(3)
     _probe_at(ctx, state, _centre(state))
     out["kd_after"] = state.scene.materials["white"].kd
-    out["gpu_after"] = state.probe.gpu.tolist()
-    out["reference_after"] = state.probe.reference.tolist()
+    out["gpu_after"] = state.probe.result.gpu.tolist()
+    out["reference_after"] = state.probe.result.reference.tolist()
     out["uploads_after"] = len(_gl_side().renderer._gpu)
     assert keys_before == [g.key for g in _gl_side().renderer._gpu.values()]
     ctx.key_press(imgui_key("mod_ctrl") | imgui_key("z"))
@@ -181,30 +181,31 @@ def scenario_kd_slider(ctx, state, out: dict) -> None:
     ctx.item_click("Add light")
     ctx.yield_(3)
     _probe_at(ctx, state, _centre(state))
-    out["two_lights"] = [len(state.scene.lights), len(state.probe.terms.lights)]
-    out["two_lights_gpu"] = state.probe.gpu.tolist()
-    out["two_lights_reference"] = state.probe.reference.tolist()
+    out["two_lights"] = [len(state.scene.lights), len(state.probe.result.terms.lights)]
+    out["two_lights_gpu"] = state.probe.result.gpu.tolist()
+    out["two_lights_reference"] = state.probe.result.reference.tolist()
     ctx.item_uncheck("light1/##on")
     ctx.yield_(3)
     _probe_at(ctx, state, _centre(state))
     out["light_off"] = [len(state.scene.lights), len(state.scene.active_lights())]
-    out["light_off_gpu"] = state.probe.gpu.tolist()
+    out["light_off_gpu"] = state.probe.result.gpu.tolist()
     ctx.key_press(imgui_key("s"))  # viewport screenshot with the legend burned in
     ctx.yield_(3)
     out["screenshots"] = sorted(p.name for p in Path(OUT_DIR).glob("shadelab-*.png"))
-    out["viewport"] = list(state.viewport_size)
+    out["viewport"] = list(state.view.viewport_size)
 
 
 def scenario_shading_modes(ctx, state, out: dict) -> None:
     ctx.yield_(3)
     out["modes"], out["gpu"], out["reference"] = [], [], []
-    pixel = (state.viewport_size[0] // 2, int(state.viewport_size[1] * 0.2))  # the ceiling
+    w, h = state.view.viewport_size
+    pixel = (w // 2, int(h * 0.2))  # the ceiling
 
     def record(mode: str) -> None:
         _probe_at(ctx, state, pixel)
         out["modes"].append(mode)
-        out["gpu"].append(state.probe.gpu.tolist())
-        out["reference"].append(state.probe.reference.tolist())
+        out["gpu"].append(state.probe.result.gpu.tolist())
+        out["reference"].append(state.probe.result.reference.tolist())
 
     for key, mode in (("_1", "flat"), ("_2", "gouraud"), ("_3", "phong")):
         ctx.key_press(imgui_key(key))
@@ -228,10 +229,10 @@ def scenario_probe_click(ctx, state, out: dict) -> None:
     ctx.yield_(3)
     ctx.set_ref("//Viewport")
     ctx.item_click("viewport_input")
-    ok = _wait(ctx, lambda: state.probe is not None and not state.probe_requested)
+    ok = _wait(ctx, lambda: state.probe.result is not None and not state.probe.requested)
     assert ok, "the click did not probe"
-    p = state.probe
-    out["pixel"], out["viewport"] = list(p.pixel), list(state.viewport_size)
+    p = state.probe.result
+    out["pixel"], out["viewport"] = list(p.pixel), list(state.view.viewport_size)
     out["gpu"], out["reference"] = p.gpu.tolist(), p.reference.tolist()
     terms = p.terms
     total = terms.emission + terms.ambient + sum(t.diffuse + t.specular for t in terms.lights)
@@ -300,31 +301,31 @@ def scenario_jobs(ctx, state, out: dict) -> None:
         finally:
             closed.set()
 
-    state.job_kinds = [JobKind("Slow test job", slow)] + available_jobs()
+    state.offline.kinds = [JobKind("Slow test job", slow)] + available_jobs()
     ctx.yield_(2)
     ctx.window_focus("//Offline render")
     ctx.set_ref("//Offline render")
     ctx.item_click("Start")
-    _wait(ctx, lambda: state.job.running)
+    _wait(ctx, lambda: state.offline.runner.running)
     frame0 = state.frame
     ctx.yield_(20)
     out["frames_while_running"] = state.frame - frame0
     ctx.item_click("Cancel")
-    _wait(ctx, lambda: not state.job.running)
-    out["cancel_latency_s"] = state.job.finished - state.job.cancel_requested
-    out["cancelled"] = bool(state.job.cancelled and closed.is_set())
-    out["cancel_fraction"] = state.job.snapshot()[0].fraction
-    state.job_kind = 1  # the numpy reference raster
-    state.job_size = 64
+    _wait(ctx, lambda: not state.offline.runner.running)
+    out["cancel_latency_s"] = state.offline.runner.finished - state.offline.runner.cancel_requested
+    out["cancelled"] = bool(state.offline.runner.cancelled and closed.is_set())
+    out["cancel_fraction"] = state.offline.runner.snapshot()[0].fraction
+    state.offline.kind = 1  # the numpy reference raster
+    state.offline.size = 64
     ctx.yield_(2)
     ctx.item_click("Start")
-    _wait(ctx, lambda: state.job.started and not state.job.running, 2000)
+    _wait(ctx, lambda: state.offline.runner.started and not state.offline.runner.running, 2000)
     # the UI may have compared a partial image first: wait until the final one is uploaded
-    _wait(ctx, lambda: state.job_compare is not None
-          and state.job_version == state.job.snapshot()[1])
-    out["reference_done"] = state.job.snapshot()[0].fraction == 1.0
-    out["reference_rmse"] = state.job_compare["rmse"]
-    out["reference_flip"] = state.job_compare.get("flip")
+    _wait(ctx, lambda: state.offline.comparison is not None
+          and state.offline.version == state.offline.runner.snapshot()[1])
+    out["reference_done"] = state.offline.runner.snapshot()[0].fraction == 1.0
+    out["reference_rmse"] = state.offline.comparison["rmse"]
+    out["reference_flip"] = state.offline.comparison.get("flip")
 
 
 def scenario_smoke(ctx, state, out: dict) -> None:
@@ -341,9 +342,10 @@ def scenario_smoke(ctx, state, out: dict) -> None:
     ctx.yield_(3)
     light = state.scene.lights[0]
     out["light"] = [light.kind, light.attenuation, light.c1]
-    _probe_at(ctx, state, (state.viewport_size[0] // 2, int(state.viewport_size[1] * 0.85)))
-    out["spot_gpu"], out["spot_reference"] = state.probe.gpu.tolist(), \
-        state.probe.reference.tolist()
+    w, h = state.view.viewport_size
+    _probe_at(ctx, state, (w // 2, int(h * 0.85)))
+    out["spot_gpu"], out["spot_reference"] = state.probe.result.gpu.tolist(), \
+        state.probe.result.reference.tolist()
     keys = {i: g.key for i, g in _gl_side().renderer._gpu.items()}
     ctx.window_focus("//Objects")
     ctx.yield_(3)
@@ -359,11 +361,11 @@ def scenario_smoke(ctx, state, out: dict) -> None:
     for key in toggles.values():
         ctx.key_press(imgui_key(key))
         ctx.yield_(2)
-    out["toggles"] = {name: getattr(state, name) for name in toggles}
+    out["toggles"] = {name: getattr(state.view, name) for name in toggles}
     for key in toggles.values():
         ctx.key_press(imgui_key(key))
         ctx.yield_(2)
-    out["after_toggles"] = {name: getattr(state, name) for name in toggles}
+    out["after_toggles"] = {name: getattr(state.view, name) for name in toggles}
 
 
 OUT_DIR = "."

@@ -141,11 +141,11 @@ def _blocked(state, point) -> bool:
 
 def _shadowed_pixel(ctx, state):
     """A viewport pixel whose surface point the light cannot see (S = 0)."""
-    w, h = state.viewport_size
+    w, h = state.view.viewport_size
     for fy in (0.75, 0.8, 0.85, 0.7, 0.9):
         for fx in (0.15, 0.2, 0.25, 0.1, 0.6, 0.65):
             _probe_at(ctx, state, (int(w * fx), int(h * fy)))
-            p = state.probe
+            p = state.probe.result
             if p is not None and _blocked(state, p.point):
                 return (int(w * fx), int(h * fy))
     raise AssertionError("no shadowed pixel found")
@@ -154,15 +154,15 @@ def _shadowed_pixel(ctx, state):
 def scenario_shadows(ctx, state, out: dict) -> None:
     ctx.yield_(3)
     pixel = _shadowed_pixel(ctx, state)
-    out["gpu_before"] = state.probe.gpu.tolist()
+    out["gpu_before"] = state.probe.result.gpu.tolist()
     _open_algorithms(ctx)
     ctx.combo_click("shadows/shadow volumes")
     ctx.yield_(3)
     _probe_at(ctx, state, pixel)
     out["shadows"] = state.scene.render.shadows
-    out["S"] = 0.0 if _blocked(state, state.probe.point) else 1.0
-    out["gpu_after"] = state.probe.gpu.tolist()
-    terms = state.probe.terms      # S_i = 0 leaves Le + Ia ka Od
+    out["S"] = 0.0 if _blocked(state, state.probe.result.point) else 1.0
+    out["gpu_after"] = state.probe.result.gpu.tolist()
+    terms = state.probe.result.terms      # S_i = 0 leaves Le + Ia ka Od
     out["reference_after"] = (terms.emission + terms.ambient).tolist()
     ctx.combo_click("stencil counting/z-pass")
     ctx.yield_(3)
@@ -185,7 +185,7 @@ def _choose_pipeline(ctx, label: str) -> None:
 def scenario_raytrace_pipeline(ctx, state, out: dict) -> None:
     from shadelab.ui import pipelines
 
-    state.render_scale = 0.5
+    state.view.render_scale = 0.5
     ctx.yield_(3)
     _choose_pipeline(ctx, "ray tracing (Whitted)")
     view = pipelines.view_of(state)
@@ -201,14 +201,14 @@ def scenario_raytrace_pipeline(ctx, state, out: dict) -> None:
     out["frames_while_refining"] = state.frame - frame0
     out["size"] = list(view.job_size)
     np.save(Path(OUT_DIR) / "viewport.npy", view.linear)
-    out["pipeline"] = state.pipeline
+    out["pipeline"] = state.view.pipeline
 
 
 def scenario_follow_edits(ctx, state, out: dict) -> None:
     from shadelab.lab.pipeline_jobs import pipeline_raytrace
     from shadelab.ui import pipelines
 
-    state.render_scale = 0.3
+    state.view.render_scale = 0.3
     ctx.yield_(3)
     pipelines.set_pipeline(state, "raytrace")
     view = pipelines.view_of(state)
@@ -270,7 +270,7 @@ def scenario_bad_input(ctx, state, out: dict) -> None:
     ctx.yield_(3)
     _open_algorithms(ctx)
     out["patches_before"] = state.scene.radiosity.patches
-    out["path_spp_before"] = state.job_spp
+    out["path_spp_before"] = state.offline.spp
     ctx.item_input_value("spp (anti-aliasing)", -4)
     ctx.yield_(2)
     ctx.item_input_value("patches", 0)
@@ -279,7 +279,7 @@ def scenario_bad_input(ctx, state, out: dict) -> None:
     ctx.yield_(3)
     out["spp"] = state.scene.raytrace.spp
     out["patches"] = state.scene.radiosity.patches
-    out["path_spp"] = state.job_spp
+    out["path_spp"] = state.offline.spp
     messages = render_panel._refused
     out["spp_message"] = messages.get("RaytraceSettings.spp", "")
     out["patches_message"] = messages.get("RadiositySettings.patches", "")

@@ -146,11 +146,11 @@ def _check_layout(ctx, state, out: dict) -> None:
     from imgui_bundle import imgui
     from imgui_bundle.immapp import testing  # noqa: F401  (the engine's context)
 
-    state.presenter = True
-    state.probe_pixel, state.probe_requested = (200, 200), True
+    state.view.presenter = True
+    state.probe.pixel, state.probe.requested = (200, 200), True
     ctx.yield_(10)  # fonts, the one-column layout and the probe settle
     for _ in range(600):  # the Offline panel lists its renderers once a thread found them
-        if state.job_kinds is not None:
+        if state.offline.kinds is not None:
             break
         ctx.yield_()
     ctx.yield_(2)
@@ -214,7 +214,7 @@ def _check_layout(ctx, state, out: dict) -> None:
 
     windows = hello_imgui.get_runner_params().docking_params.dockable_windows
     out["hidden_visible"] = [w.label for w in windows if w.is_visible]
-    out["presenter_viewport"] = list(state.viewport_size)
+    out["presenter_viewport"] = list(state.view.viewport_size)
     out["caption"] = caption_text(state)
     capture(ctx, str(Path(OUT_DIR) / "presenter-tab.png"))
     ctx.key_press(imgui.Key.tab)
@@ -235,23 +235,23 @@ def scenario_lesson_walk(ctx, state, out: dict) -> None:
 
     from shadelab.lab.lesson import LessonRun, go_to, load_lesson
 
-    state.lesson = LessonRun(load_lesson("phong-to-radiosity"))
+    state.walk.lesson = LessonRun(load_lesson("phong-to-radiosity"))
     go_to(state, 0)
     ctx.yield_(3)
     from shadelab.lab.lesson_file import SHOW_TOGGLES
 
     presets, captions, indices, errors, toggles = [], [], [], [], []
-    for i in range(len(state.lesson.lesson.steps)):
+    for i in range(len(state.walk.lesson.lesson.steps)):
         if i:
             ctx.key_press(imgui.Key.page_down)
             ctx.yield_(3)
         presets.append(state.scene.name)
-        captions.append(state.lesson.step.caption)
-        indices.append(state.lesson.index)
+        captions.append(state.walk.lesson.step.caption)
+        indices.append(state.walk.lesson.index)
         errors.append(state.error)
         toggles.append(sorted(name for name, attr in SHOW_TOGGLES.items()
-                              if getattr(state, attr)))
-        if state.lesson.step.title == "Ambient light":   # the light is off: Ia ka alone
+                              if getattr(state.view, attr)))
+        if state.walk.lesson.step.title == "Ambient light":   # the light is off: Ia ka alone
             out["ambient_light_enabled"] = state.scene.lights[0].enabled
             out["ambient_shadows"] = state.scene.render.shadows
         if i == 0:   # the normals step: its light sits beside the eye (the gizmo is skipped)
@@ -265,7 +265,7 @@ def scenario_lesson_walk(ctx, state, out: dict) -> None:
     ctx.yield_(2)
     ctx.key_press(imgui.Key.page_up)
     ctx.yield_(3)
-    out["after_page_up"] = state.lesson.index
+    out["after_page_up"] = state.walk.lesson.index
     out.update(presets=presets, captions=captions, indices=indices, errors=errors,
                toggles=toggles)
 
@@ -278,14 +278,14 @@ def scenario_gizmo_drag(ctx, state, out: dict) -> None:
     state.scene.camera.eye, state.scene.camera.target = (0.0, 1.0, 6.0), (0.0, 1.0, 0.0)
     state.scene.lights[0].position = (0.5, 1.2, 0.0)
     state.mark_edited()
-    state.show_fps = False
+    state.view.show_fps = False
     ctx.yield_(6)
     steps_before = state.history.index
     before = list(state.scene.lights[0].position)
     camera = tuple(state.scene.camera.eye)
     info = ctx.item_info("//Viewport/viewport_input")
     origin = info.rect_full.min
-    size = state.viewport_size
+    size = state.view.viewport_size
     project, _, _ = gizmos.projector(state, size)
     x, y = project(before)
     start = imgui.ImVec2(origin.x + x, origin.y + y)
@@ -313,7 +313,7 @@ def scenario_lesson_panel(ctx, state, out: dict) -> None:
     viewport's caption step it (they stay in reach whichever panel a step brings forward)."""
     from imgui_bundle import imgui
 
-    state.presenter = True
+    state.view.presenter = True
     ctx.yield_(5)
     ctx.window_focus("//Scene")
     ctx.set_ref("//Scene")
@@ -323,22 +323,22 @@ def scenario_lesson_panel(ctx, state, out: dict) -> None:
     ctx.item_click("//$FOCUSED/phong-to-radiosity", 0,
                    imgui.test_engine.TestOpFlags_.no_check_hovered_id)
     ctx.yield_(4)
-    run = state.lesson
+    run = state.walk.lesson
     out["picked"] = [Path(run.lesson.path).stem, run.index, state.scene.name]
     ctx.set_ref("//Viewport")
     ctx.item_click("Next > (PgDn)")
     ctx.yield_(3)
-    out["after_next"], out["scene_after_next"] = state.lesson.index, state.scene.name
+    out["after_next"], out["scene_after_next"] = state.walk.lesson.index, state.scene.name
     ctx.item_click("< Prev (PgUp)")
     ctx.yield_(3)
-    out["after_prev"] = state.lesson.index
+    out["after_prev"] = state.walk.lesson.index
     capture(ctx, str(Path(OUT_DIR) / "lesson-buttons.png"))
     ctx.window_focus("//Scene")
     ctx.set_ref("//Scene")
     ctx.item_click("Lesson")
     ctx.item_click("//$FOCUSED/(none)")
     ctx.yield_(3)
-    out["after_none"], out["scene_after_none"] = state.lesson, state.scene.name
+    out["after_none"], out["scene_after_none"] = state.walk.lesson, state.scene.name
 
 
 def scenario_camera_framing(ctx, state, out: dict) -> None:
@@ -382,27 +382,29 @@ def scenario_hygiene(ctx, state, out: dict) -> None:
     out["kept_after_cancel"] = state.scene.name
     out["edits_kept_after_cancel"] = state.scene.materials["plastic"].kd
     # overlays belong to the scene the job rendered
-    state.job_scene = clone_scene(state.scene)
-    state.radiosity_soup = np.zeros((3, 6), np.float32)
-    state.ray_tree = object()
+    state.offline.scene = clone_scene(state.scene)
+    state.offline.radiosity_soup = np.zeros((3, 6), np.float32)
+    state.offline.ray_tree = object()
     ctx.yield_(3)
-    out["overlays_before"] = [state.radiosity_soup is not None, state.ray_tree is not None]
-    state.ray_tree = None  # (a dummy tree cannot be drawn; a real one is a RayNode)
+    out["overlays_before"] = [state.offline.radiosity_soup is not None,
+                              state.offline.ray_tree is not None]
+    state.offline.ray_tree = None  # (a dummy tree cannot be drawn; a real one is a RayNode)
     ctx.set_ref("//Viewport")
     eye = tuple(state.scene.camera.eye)
     ctx.item_drag_with_delta("viewport_input", imgui.ImVec2(50, 0))
     ctx.yield_(3)
-    state.ray_tree = "tree"  # stands for a tree: only its presence is checked below
+    state.offline.ray_tree = "tree"  # stands for a tree: only its presence is checked below
     state.scene_version += 1
     ctx.yield_(2)
-    out["overlays_after_camera_move"] = [state.radiosity_soup is not None,
-                                         state.ray_tree is not None]
+    out["overlays_after_camera_move"] = [state.offline.radiosity_soup is not None,
+                                         state.offline.ray_tree is not None]
     moved_eye = tuple(state.scene.camera.eye)
-    state.ray_tree = None
+    state.offline.ray_tree = None
     state.scene.materials["plastic"].kd = 0.3
     state.mark_edited()
     ctx.yield_(3)
-    out["overlays_after_edit"] = [state.radiosity_soup is not None, state.ray_tree is not None]
+    out["overlays_after_edit"] = [state.offline.radiosity_soup is not None,
+                                  state.offline.ray_tree is not None]
     ctx.key_press(int(imgui.Key.mod_ctrl) | int(imgui.Key.z))
     ctx.yield_(3)
     out["camera_undo"] = moved_eye != eye and tuple(state.scene.camera.eye) == moved_eye
@@ -438,7 +440,7 @@ def scenario_dialogs(ctx, state, out: dict) -> None:
     import trimesh
 
     from shadelab.scene.preset import load_preset
-    from shadelab.ui import dialogs, panels
+    from shadelab.ui import dialogs, lights_panel
 
     mesh_path = Path(OUT_DIR) / "tet.obj"
     trimesh.creation.icosphere(1).export(mesh_path)
@@ -475,16 +477,16 @@ def scenario_dialogs(ctx, state, out: dict) -> None:
     out["dropped"] = state.scene.name
     # an exception inside an open ImGui scope (a tree node of the Lights panel)
 
-    original = panels._light_rows
+    original = lights_panel._light_rows
 
     def broken(light, span):
         raise UnicodeDecodeError("utf-8", b"\xff", 0, 1, "boom")
 
-    panels._light_rows = broken
+    lights_panel._light_rows = broken
     ctx.window_focus("//Lights")
     ctx.yield_(5)
     out["panel_error"] = state.error
-    panels._light_rows = original
+    lights_panel._light_rows = original
     frame = state.frame
     ctx.yield_(5)
     out["frames_after_error"] = state.frame - frame

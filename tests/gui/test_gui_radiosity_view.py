@@ -164,7 +164,7 @@ def scenario_hemicube_window(ctx, state, out: dict) -> None:
 def _pixel_of(state, point) -> tuple[int, int]:
     from shadelab.ui import pipelines
 
-    xy, front = pipelines.project(state.scene, state.viewport_size, np.array([point]))
+    xy, front = pipelines.project(state.scene, state.view.viewport_size, np.array([point]))
     assert front[0]
     return int(xy[0, 0]), int(xy[0, 1])
 
@@ -172,7 +172,7 @@ def _pixel_of(state, point) -> tuple[int, int]:
 def _gpu(ctx, state, pixel) -> list:
     ctx.yield_(3)
     _probe_at(ctx, state, pixel)
-    return state.probe.gpu.tolist()
+    return state.probe.result.gpu.tolist()
 
 
 def _case(ctx, state, material: str, obj_name: str, point) -> dict:
@@ -226,10 +226,10 @@ def _raster(ctx, state, out: dict, name: str) -> None:
     ctx.combo_click(f"Pipeline/{pipelines.LABELS[name]}")
     ctx.yield_(6)
     out["render"] = [state.scene.render.shading, state.scene.render.visibility]
-    out["exposure"], out["tonemap"] = state.scene.render.exposure, str(state.tonemap)
+    out["exposure"], out["tonemap"] = state.scene.render.exposure, str(state.view.tonemap)
     # GL reads belong to the UI thread (this coroutine has no context): its screenshot
     path = Path(OUT_DIR) / f"{name}.png"
-    state.legend_in_screenshot = False
+    state.view.legend_in_screenshot = False
     state.screenshot_requested = str(path)
     assert _wait(ctx, lambda: path.exists() and not state.screenshot_requested, 100)
     ctx.yield_(2)

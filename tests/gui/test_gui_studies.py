@@ -56,7 +56,7 @@ def test_open_case_replaces_the_scene_like_open_preset():
     state.commit_edit()
     assert state.history.can_undo()
     assert open_case(state, case_named("shininess-huge"))
-    assert state.source == "fail-coefficients" and state.gallery_opened == "shininess-huge"
+    assert state.source == "fail-coefficients" and state.studies.gallery_opened == "shininess-huge"
     assert state.scene.materials["paint"].n == 10000.0 and state.scene.render.shading == "phong"
     assert not state.dirty and state.error == ""
     # opening a case is one undoable step, like loading a preset: undo brings the edit back
@@ -221,24 +221,25 @@ def scenario_gallery(ctx, state, out: dict) -> None:
     frame0 = state.frame
     ctx.item_click("**/gouraud-highlight  (raster:gouraud)")
     ctx.item_click("Open in viewer")
-    _wait(ctx, lambda: state.gallery_opened == "gouraud-highlight", 60)
+    _wait(ctx, lambda: state.studies.gallery_opened == "gouraud-highlight", 60)
     out["gouraud"] = [state.source, state.scene.render.shading, state.error]
     ctx.item_click("**/flat-curved  (raster:flat)")
     ctx.item_click("Open in viewer")
-    _wait(ctx, lambda: state.gallery_opened == "flat-curved", 60)
+    _wait(ctx, lambda: state.studies.gallery_opened == "flat-curved", 60)
     out["flat"] = [state.source, state.scene.render.shading, state.scene.objects[0].subdivisions,
                    state.error]
     ctx.item_click("**/broken-test-case  (raster:phong)")
     ctx.item_click("Open in viewer")
     _wait(ctx, lambda: bool(state.error), 60)
     out["broken"] = [state.source, state.error]
-    state.error, state.job_size = "", 32
-    state.gallery_index = [c.name for c in GALLERY].index("shadow-acne")
+    state.error, state.offline.size = "", 32
+    state.studies.gallery_index = [c.name for c in GALLERY].index("shadow-acne")
     ctx.yield_(2)
     ctx.item_click("Run offline job")
-    _wait(ctx, lambda: state.job.started, 60)
-    out["offline"] = [state.source, state.scene.raytrace.offset, state.job.name, state.error]
-    state.job.cancel(wait=True)
+    _wait(ctx, lambda: state.offline.runner.started, 60)
+    out["offline"] = [state.source, state.scene.raytrace.offset, state.offline.runner.name,
+                      state.error]
+    state.offline.runner.cancel(wait=True)
     ctx.yield_(2)
     out["frames_drawn"] = state.frame - frame0
 
@@ -250,18 +251,18 @@ def scenario_studies(ctx, state, out: dict) -> None:
     ctx.window_focus("//Studies")
     ctx.set_ref("//Studies")
     ctx.item_click("Run (quick)")
-    _wait(ctx, lambda: state.study is not None and state.study.running, 60)
+    _wait(ctx, lambda: state.studies.run is not None and state.studies.run.running, 60)
     frame0 = state.frame
-    _wait(ctx, lambda: not state.study.running, 3000)
+    _wait(ctx, lambda: not state.studies.run.running, 3000)
     out["frames_while_running"] = state.frame - frame0
-    _wait(ctx, lambda: state.study_plotted > 0, 30)
-    result = state.study.result
-    out["error"] = state.study.error
+    _wait(ctx, lambda: state.studies.plotted > 0, 30)
+    result = state.studies.run.result
+    out["error"] = state.studies.run.error
     out["name"] = result.name if result else ""
     out["rows"] = len(result.rows) if result else 0
     out["columns"] = list(result.columns) if result else []
-    out["plotted"] = state.study_plotted
-    out["auto_quality"] = auto_quality_line(result, state.study_budget) if result else ""
+    out["plotted"] = state.studies.plotted
+    out["auto_quality"] = auto_quality_line(result, state.studies.budget) if result else ""
 
 
 def _main(name: str, out_dir: str) -> int:

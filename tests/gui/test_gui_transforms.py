@@ -81,7 +81,7 @@ def _viewport_image(ctx, state, name: str) -> np.ndarray:
     from PIL import Image
 
     path = Path(OUT_DIR) / f"{name}.png"
-    state.legend_in_screenshot = False
+    state.view.legend_in_screenshot = False
     state.screenshot_requested = str(path)
     for _ in range(100):
         ctx.yield_()
@@ -109,7 +109,7 @@ def _one_sphere(state) -> None:
     scene.camera.up = (0.0, 1.0, 0.0)
     scene.render.background = (0.0, 0.0, 0.0)
     scene.render.shadows = "none"
-    state.show_fps, state.show_gizmos = False, False
+    state.view.show_fps, state.view.show_gizmos = False, False
     state.mark_edited()
 
 

@@ -12,8 +12,9 @@ from shadelab.ui.followups import FollowUps, ViewerOptions, open_gallery_case
 
 def _state(**job):
     state = AppState.from_scene(load_preset("cornell"), "cornell")
-    state.job = SimpleNamespace(**{"running": False, "started": True, "version": 0, **job})
-    state.job_version = 0
+    runner = {"running": False, "started": True, "version": 0, **job}
+    state.offline.runner = SimpleNamespace(**runner)
+    state.offline.version = 0
     return state
 
 
@@ -30,13 +31,13 @@ def test_frames_quit_at_the_count_when_nothing_is_asked_for():
 def test_frames_count_after_the_job_and_then_the_job_is_followed_up():
     follow = FollowUps(ViewerOptions(frames=2, job="radiosity", show_radiosity=True))
     state = _state(running=True)
-    state.frame, state.radiosity_soup = 10, object()
-    assert not follow.end_frame(state) and not state.show_radiosity  # still running
-    state.job.running = False
-    state.job_version = -1                  # its last image not uploaded yet
+    state.frame, state.offline.radiosity_soup = 10, object()
+    assert not follow.end_frame(state) and not state.offline.show_radiosity  # still running
+    state.offline.runner.running = False
+    state.offline.version = -1                  # its last image not uploaded yet
     assert not follow.end_frame(state)
-    state.job_version = 0
-    assert follow.end_frame(state) and state.show_radiosity and follow.job_followed_up
+    state.offline.version = 0
+    assert follow.end_frame(state) and state.offline.show_radiosity and follow.job_followed_up
 
 
 def test_a_bad_gallery_name_is_an_error_naming_the_cases():

@@ -65,14 +65,14 @@ def test_a_step_switches_on_its_view_toggles_and_off_the_rest(tmp_path):
     path.write_text('name = "v"\n' + GOOD_STEP + 'show = ["compare", "normals"]\n'
                     + GOOD_STEP.replace("Ambient", "Plain"))
     state = AppState.from_scene(load_preset("lecture"), "lecture")
-    state.show_wireframe = True
-    state.lesson = LessonRun(load_lesson(str(path)))
+    state.view.show_wireframe = True
+    state.walk.lesson = LessonRun(load_lesson(str(path)))
     assert go_to(state, 0)
-    on = {name for name, attr in SHOW_TOGGLES.items() if getattr(state, attr)}
+    on = {name for name, attr in SHOW_TOGGLES.items() if getattr(state.view, attr)}
     assert on == {"compare", "normals"}
     assert go_to(state, 1)
-    assert not any(getattr(state, attr) for attr in SHOW_TOGGLES.values())
-    assert Path(state.lesson.step.preset).stem == "lecture"
+    assert not any(getattr(state.view, attr) for attr in SHOW_TOGGLES.values())
+    assert Path(state.walk.lesson.step.preset).stem == "lecture"
 
 
 def _edited_state() -> AppState:
@@ -92,8 +92,8 @@ def test_opening_or_dropping_a_lesson_file_starts_it(tmp_path):
     state = AppState.from_scene(load_preset("sphere-shading"), "sphere-shading")
     dialogs.on_drop([str(path)])
     dialogs.take_dropped(state)
-    assert state.error == "" and state.lesson is not None
-    assert state.lesson.step is None            # the viewer shows step 1 at the frame's end
+    assert state.error == "" and state.walk.lesson is not None
+    assert state.walk.lesson.step is None            # the viewer shows step 1 at the frame's end
     assert go_to(state, 0) and state.scene.name == "lecture"
 
 

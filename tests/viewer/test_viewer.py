@@ -409,7 +409,7 @@ def test_save_never_overwrites_a_shipped_preset(tmp_path, monkeypatch):
     """Save (and Ctrl+S) on a preset ShadeLab ships asks where (Save as) and leaves the file;
     on the user's own file it writes in place."""
     from shadelab.resources import presets_dir
-    from shadelab.ui import dialogs, panels
+    from shadelab.ui import dialogs, scene_panel
 
     asked = []
     monkeypatch.setattr(dialogs, "ask", lambda state, purpose: asked.append(purpose))
@@ -419,14 +419,14 @@ def test_save_never_overwrites_a_shipped_preset(tmp_path, monkeypatch):
     state.preset_path = str(shipped)
     state.scene.materials["white"].kd = 0.5
     try:
-        panels.save_here(state)
+        scene_panel.save_here(state)
         assert asked == ["save"] and shipped.read_bytes() == before
     finally:  # a regression must not leave the shipped preset changed
         if shipped.read_bytes() != before:
             shipped.write_bytes(before)
     own = tmp_path / "mine.toml"
     state.preset_path = str(own)
-    panels.save_here(state)
+    scene_panel.save_here(state)
     assert asked == ["save"] and load_preset(str(own)).materials["white"].kd == 0.5
 
 

@@ -85,12 +85,12 @@ class _Shown:
 def test_viewport_screenshot_is_the_shown_image(tmp_path, np_rng):
     image = np_rng.integers(0, 256, (30, 40, 3), dtype=np.uint8)
     state = _state()
-    state.legend_in_screenshot = False
+    state.view.legend_in_screenshot = False
     path = tmp_path / "shot.png"
     write_viewport_screenshot(state, _Shown(image), str(path))
     np.testing.assert_array_equal(np.asarray(Image.open(path)), image)
     assert state.status == f"screenshot {path}" and not state.error
-    state.legend_in_screenshot = True            # the legend is burnt into the pixels
+    state.view.legend_in_screenshot = True            # the legend is burnt into the pixels
     write_viewport_screenshot(state, _Shown(image), str(path))
     assert not np.array_equal(np.asarray(Image.open(path)), image)
 
@@ -118,17 +118,17 @@ def test_probe_maps_the_shown_pixel_to_the_rendered_one_and_reads_the_gpu(gl_ctx
     try:
         vp.draw_scene("main", scene, size, scene.render.shading, scene.render.specular,
                       samples)
-        state.probe_pixel, state.probe_requested = (41, 33), True
+        state.probe.pixel, state.probe.requested = (41, 33), True
         update_probe(state, vp, size, display, samples)
-        assert not state.probe_requested and state.probe_version == 1
-        assert state.probe.pixel == (20, 16)      # (41 * 40 / 80, 33 * 30 / 60)
+        assert not state.probe.requested and state.probe.version == 1
+        assert state.probe.result.pixel == (20, 16)      # (41 * 40 / 80, 33 * 30 / 60)
         key = "probe" if samples > 1 else "main"  # MSAA: one sample, drawn again
-        np.testing.assert_array_equal(state.probe.gpu, vp.read_pixel(key, (20, 16)))
+        np.testing.assert_array_equal(state.probe.result.gpu, vp.read_pixel(key, (20, 16)))
         assert ("probe" in vp.panes) == (samples > 1)
-        np.testing.assert_allclose(state.probe.gpu, state.probe.reference, rtol=1e-4,
+        np.testing.assert_allclose(state.probe.result.gpu, state.probe.result.reference, rtol=1e-4,
                                    atol=1e-5)
-        state.probe_pixel = (80, 10)              # off the viewport: no probe
+        state.probe.pixel = (80, 10)              # off the viewport: no probe
         update_probe(state, vp, size, display, samples)
-        assert state.probe is None and state.probe_version == 2
+        assert state.probe.result is None and state.probe.version == 2
     finally:
         vp.release()

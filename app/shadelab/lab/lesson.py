@@ -38,8 +38,8 @@ from shadelab.lab.lesson_file import (  # noqa: F401
 
 
 def go_to(state, index: int) -> bool:
-    """Show step ``index`` of ``state.lesson`` (clamped); the load is undoable."""
-    run = state.lesson
+    """Show step ``index`` of ``state.walk.lesson`` (clamped); the load is undoable."""
+    run = state.walk.lesson
     if run is None:
         return False
     index = max(0, min(index, len(run.lesson.steps) - 1))
@@ -57,9 +57,9 @@ def go_to(state, index: int) -> bool:
     state.pending_open = ""
     apply_pipeline(state, step.pipeline)
     for name, attr in SHOW_TOGGLES.items():
-        setattr(state, attr, name in step.show)
+        setattr(state.view, attr, name in step.show)
     if step.focus:
-        state.focus_request = step.focus
+        state.walk.focus_request = step.focus
     state.error, state.status = "", f"lesson step {index + 1}/{len(run.lesson.steps)}: " \
                                      f"{step.title}"
     return True
@@ -80,10 +80,10 @@ def apply_pipeline(state, name: str) -> None:
 
 
 def next_step(state) -> None:
-    if state.lesson is not None:
-        go_to(state, state.lesson.index + 1)
+    if state.walk.lesson is not None:
+        go_to(state, state.walk.lesson.index + 1)
 
 
 def previous_step(state) -> None:
-    if state.lesson is not None:
-        go_to(state, state.lesson.index - 1)
+    if state.walk.lesson is not None:
+        go_to(state, state.walk.lesson.index - 1)

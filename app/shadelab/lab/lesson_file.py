@@ -13,7 +13,7 @@ from shadelab.scene.preset import load_preset, read_toml
 
 STEP_KEYS = {"title", "caption", "preset", "set", "pipeline", "focus", "show"}
 # View toggles a step may switch on (every other one is off while the step shows):
-# name -> the AppState field it sets
+# A lesson step's ``show`` names and the ViewState fields they switch on (state.view).
 SHOW_TOGGLES = {"compare": "compare", "diff": "diff_enabled", "normals": "show_normals",
                 "wireframe": "show_wireframe", "patches": "radiosity_patches"}
 

@@ -1,5 +1,6 @@
-"""The viewer's state: :class:`AppState` made of typed sub-states (view, probe, job, study,
-lesson), plus undo history and the autosaved session.
+"""The viewer's state: :class:`AppState` made of typed sub-states (``state.view``,
+``state.probe``, ``state.offline``, ``state.studies``, ``state.walk``), with its undo history
+(:mod:`shadelab.lab.history`) and the autosaved session (:mod:`shadelab.lab.session`).
 
 Pure module (no GL, no GUI): the panels read and write an :class:`AppState`; the GL side keeps
 its resources elsewhere (:mod:`shadelab.ui.viewport`, :mod:`shadelab.ui.gpu_side`). What the
@@ -15,6 +16,7 @@ from typing import TYPE_CHECKING
 
 from shadelab.errors import ShadeLabError
 from shadelab.lab.gpu_queue import GpuQueue
+from shadelab.lab.history import HISTORY_LIMIT, History  # noqa: F401 (re-exported)
 
 # One file, written atomically; a damaged one is moved aside and never stops the viewer
 # (shadelab.lab.session). Re-exported here, where the viewer has always found them.
@@ -40,59 +42,7 @@ if TYPE_CHECKING:  # types only (no import at run time: the GL side stays out of
 
 COMPARE_VIEWS = (("flat", "phong"), ("gouraud", "phong"), ("phong", "phong"), ("phong", "blinn"))
 COMPARE_LABELS = ("Flat", "Gouraud", "Phong", "Blinn-Phong")
-HISTORY_LIMIT = 200          # undo snapshots kept
 AUTOSAVE_INTERVAL = 1.0      # seconds between autosaves of a changed scene
-
-
-def _without_camera(scene: Scene) -> dict:
-    d = scene_to_dict(scene)
-    d.pop("camera", None)
-    return d
-
-
-class History:
-    """Undo/redo over Scene snapshots (one per finished edit, e.g. a slider release).
-
-    Camera moves are not on the stack (an orbit is no edit to undo); opening a preset is
-    (``file`` is what the title and "Save" need to go back to the file shown before)."""
-
-    def __init__(self, scene: Scene, file: dict | None = None):
-        self.snapshots = [clone_scene(scene)]
-        self.files = [file]
-        self.index = 0
-
-    def push(self, scene: Scene, file: dict | None = None) -> None:
-        if file is None and _without_camera(scene) == _without_camera(self.snapshots[self.index]):
-            return  # nothing changed (a slider clicked but not moved, or the camera only)
-        del self.snapshots[self.index + 1:]
-        del self.files[self.index + 1:]
-        self.snapshots.append(clone_scene(scene))
-        self.files.append(file if file is not None else self.files[self.index])
-        if len(self.snapshots) > HISTORY_LIMIT:
-            self.snapshots.pop(0)
-            self.files.pop(0)
-        self.index = len(self.snapshots) - 1
-
-    def file(self) -> dict | None:
-        return self.files[self.index]
-
-    def can_undo(self) -> bool:
-        return self.index > 0
-
-    def can_redo(self) -> bool:
-        return self.index < len(self.snapshots) - 1
-
-    def undo(self) -> Scene | None:
-        if not self.can_undo():
-            return None
-        self.index -= 1
-        return clone_scene(self.snapshots[self.index])
-
-    def redo(self) -> Scene | None:
-        if not self.can_redo():
-            return None
-        self.index += 1
-        return clone_scene(self.snapshots[self.index])
 
 
 # ---------------------------------------------------------------- sub-states
@@ -141,27 +91,27 @@ class ViewState:
 class ProbeState:
     """The probed pixel and what the probe found there (shadelab.lab.probe)."""
 
-    probe_pixel: tuple[int, int] | None = None
-    probe: ProbeResult | None = None
-    probe_requested: bool = False
-    probe_version: int = 0            # bumped on every new probe result
+    pixel: tuple[int, int] | None = None   # viewport pixel; None: no probe
+    result: ProbeResult | None = None
+    requested: bool = False           # probe again at the frame's end
+    version: int = 0                  # bumped on every new probe result
 
 
 @dataclass
-class JobState:
+class OfflineState:
     """The Offline render panel's job and what it left: the image's comparison with the raster
     view, a clicked pixel's ray tree, the solved radiosity triangles (shadelab.ui.offline)."""
 
-    job: JobRunner | None = None
-    job_kind: int = 0
-    job_size: int = 256                # offline panel image height, px
-    job_spp: int = 16                 # samples per pixel (path tracer; Whitted anti-aliasing)
-    job_compare: dict | None = None   # error figures vs the raster view
-    job_raster: np.ndarray | None = None  # (H, W, 3) raster image the job is compared with
-    job_kinds: list[JobKind] | None = None  # shadelab.lab.jobs.available_jobs(), on first use
-    job_version: int = -1             # the JobRunner version last uploaded
-    job_scene: Scene | None = None    # the Scene snapshot the last job rendered
-    job_size_px: tuple = (0, 0)       # its image size (width, height)
+    runner: JobRunner | None = None
+    kind: int = 0                     # index into ``kinds``
+    size: int = 256                   # offline panel image height, px
+    spp: int = 16                     # samples per pixel (path tracer; Whitted anti-aliasing)
+    comparison: dict | None = None    # error figures vs the raster view
+    raster: np.ndarray | None = None  # (H, W, 3) raster image the job is compared with
+    kinds: list[JobKind] | None = None  # shadelab.lab.jobs.available_jobs(), on first use
+    version: int = -1                 # the JobRunner version last uploaded
+    scene: Scene | None = None        # the Scene snapshot the last job rendered
+    size_px: tuple = (0, 0)           # its image size (width, height)
     ray_tree: RayNode | None = None   # the ray tree of a clicked traced pixel
     ray_tree_pixel: tuple[int, int] | None = None  # (x, y) in the job image
     radiosity_soup: np.ndarray | None = None  # (3F, 6) float32 solved display triangles
@@ -173,11 +123,11 @@ class JobState:
 class StudyState:
     """The Studies and Failure gallery panels (shadelab.ui.studies_panel)."""
 
-    study: StudyRun | None = None     # made on first use
-    study_index: int = 0              # into shadelab.studies.STUDIES
-    study_chart: int = 0              # 0: the main chart; i: the result's i-th extra table
-    study_plotted: int = 0            # points the Studies chart drew last frame
-    study_budget: float = 0.01        # auto quality's error budget (relative MSE)
+    run: StudyRun | None = None       # made on first use
+    index: int = 0                    # into shadelab.studies.STUDIES
+    chart: int = 0                    # 0: the main chart; i: the result's i-th extra table
+    plotted: int = 0                  # points the Studies chart drew last frame
+    budget: float = 0.01              # auto quality's error budget (relative MSE)
     gallery_index: int = -1           # selected case of shadelab.studies.gallery.GALLERY
     gallery_opened: str = ""          # name of the last case opened in the viewer
 
@@ -190,9 +140,34 @@ class LessonState:
     focus_request: str = ""           # panels to bring to the front next frame (a,b,...)
 
 
+# AppState's sub-states by their attribute names: ``state.view.compare``, ``state.probe.pixel``,
+# ``state.offline.runner``, ``state.studies.index``, ``state.walk.lesson``.
+SUB_STATES = {"view": ViewState, "probe": ProbeState, "offline": OfflineState,
+              "studies": StudyState, "walk": LessonState}
+
+# Remaining for the pipelines merge: the flat names that lab/pipeline_view.py, ui/pipelines.py,
+# ui/offline.py, ui/pipeline_viewport.py, ui/render_panel.py and cli/view.py still read and
+# write (``state.compare`` is ``state.view.compare``). Delete an entry once no file uses it,
+# and this table with :class:`_In` once it is empty.
+REMAINING_FLAT_NAMES = {
+    **{name: ("view", name) for name in (
+        "compare", "diff_enabled", "msaa", "pipeline", "pipeline_view", "presenter",
+        "radiosity_patches", "render_scale", "show_help", "show_normals", "show_wireframe",
+        "viewport_size", "wipe", "wipe_pipeline", "wipe_position")},
+    "job": ("offline", "runner"), "job_kind": ("offline", "kind"),
+    "job_size": ("offline", "size"), "job_spp": ("offline", "spp"),
+    "job_compare": ("offline", "comparison"), "job_raster": ("offline", "raster"),
+    "job_kinds": ("offline", "kinds"), "job_version": ("offline", "version"),
+    "job_scene": ("offline", "scene"), "job_size_px": ("offline", "size_px"),
+    **{name: ("offline", name) for name in (
+        "ray_tree", "ray_tree_pixel", "radiosity_soup", "show_radiosity", "overlay_version")},
+    "lesson": ("walk", "lesson"),
+}
+
+
 class _In:
-    """An AppState attribute kept in one of its sub-states: ``state.show_wireframe`` reads and
-    writes ``state.view_state.show_wireframe`` (the panels' names stay as they were)."""
+    """Remaining for the pipelines merge: a flat AppState name of a sub-state field
+    (:data:`REMAINING_FLAT_NAMES`)."""
 
     def __init__(self, part: str, name: str):
         self.part, self.name = part, name
@@ -206,10 +181,6 @@ class _In:
         setattr(getattr(obj, self.part), self.name, value)
 
 
-SUB_STATES = {"view_state": ViewState, "probe_state": ProbeState, "job_state": JobState,
-              "study_state": StudyState, "lesson_state": LessonState}
-
-
 # ---------------------------------------------------------------- the app state
 
 
@@ -217,19 +188,19 @@ SUB_STATES = {"view_state": ViewState, "probe_state": ProbeState, "job_state": J
 class AppState:
     """Everything the panels show and edit; one instance per viewer window.
 
-    The panels read and write the sub-states' fields under their old names (``state.compare``
-    is ``state.view_state.compare``); see :data:`SUB_STATES`."""
+    Its parts are typed sub-states (:data:`SUB_STATES`): ``state.view``, ``state.probe``,
+    ``state.offline``, ``state.studies``, ``state.walk``."""
 
     scene: Scene
     source: str                       # preset name or file the scene came from
     saved: dict = field(default_factory=dict)      # scene_to_dict at the last load/save
     initial_camera: Camera | None = None  # the preset's camera, for "reset view"
     history: History | None = None
-    view_state: ViewState = field(default_factory=ViewState)
-    probe_state: ProbeState = field(default_factory=ProbeState)
-    job_state: JobState = field(default_factory=JobState)
-    study_state: StudyState = field(default_factory=StudyState)
-    lesson_state: LessonState = field(default_factory=LessonState)
+    view: ViewState = field(default_factory=ViewState)
+    probe: ProbeState = field(default_factory=ProbeState)
+    offline: OfflineState = field(default_factory=OfflineState)
+    studies: StudyState = field(default_factory=StudyState)
+    walk: LessonState = field(default_factory=LessonState)
     # Messages
     error: str = ""                   # shown in the app (bad preset, bad mesh...)
     status: str = ""                  # last action ("saved ...", "screenshot ...")
@@ -251,13 +222,11 @@ class AppState:
     def from_scene(cls, scene: Scene, source: str, **kwargs) -> "AppState":
         from shadelab.lab.jobs import JobRunner
 
-        state = cls(scene=scene, source=source)
-        for name, value in kwargs.items():  # a sub-state's field, by its old name, too
-            setattr(state, name, value)
+        state = cls(scene=scene, source=source, **kwargs)  # AppState's own fields
         state.saved = scene_to_dict(scene)
         state.initial_camera = clone_scene(scene).camera
         state.history = History(scene, state.file_meta())
-        state.job = JobRunner()
+        state.offline.runner = JobRunner()
         return state
 
     # ------------------------------------------------------------ edits
@@ -271,12 +240,12 @@ class AppState:
         self.scene_version += 1
         self.edit_pending = True
         self.autosave_due = True
-        self.probe_requested = self.probe_pixel is not None
+        self.probe.requested = self.probe.pixel is not None
 
     def commit_edit(self) -> None:
         """Close an edit: snapshot for undo, recompute the unsaved flag."""
         self.edit_pending = False
-        self.probe_requested = self.probe_pixel is not None  # again, at full resolution
+        self.probe.requested = self.probe.pixel is not None  # again, at full resolution
         self.history.push(self.scene)
         self.dirty = scene_to_dict(self.scene) != self.saved
 
@@ -289,12 +258,12 @@ class AppState:
             self.source = source or scene.name
             self.saved = scene_to_dict(scene)
             self.initial_camera = clone_scene(scene).camera
-            self.probe_pixel, self.probe = None, None
+            self.probe.pixel, self.probe.result = None, None
             self.preset_path = ""
             self.history.push(scene, self.file_meta())  # undo goes back to the last file
         self.dirty = scene_to_dict(scene) != self.saved
         self.autosave_due = True
-        self.probe_requested = self.probe_pixel is not None
+        self.probe.requested = self.probe.pixel is not None
 
     def _go_to_snapshot(self, scene: Scene | None, what: str) -> None:
         if scene is None:
@@ -303,7 +272,7 @@ class AppState:
         if file is not None and file["source"] != self.source:
             self.source, self.saved = file["source"], file["saved"]  # another file: its camera
             self.preset_path, self.initial_camera = file["preset_path"], file["initial_camera"]
-            self.probe_pixel, self.probe = None, None
+            self.probe.pixel, self.probe.result = None, None
         else:
             scene.camera = self.scene.camera  # camera moves are not undone
         self.replace_scene(scene)
@@ -357,7 +326,7 @@ class AppState:
         except ShadeLabError as exc:
             self.error = str(exc)
             return False
-        self.lesson = LessonRun(lesson)
+        self.walk.lesson = LessonRun(lesson)
         self.error, self.status = "", f"lesson {lesson.name}: {len(lesson.steps)} steps"
         return True
 
@@ -436,8 +405,7 @@ class AppState:
         return f"ShadeLab - {name}{' *' if self.dirty else ''}"
 
 
-# The sub-states' fields under their old names (``state.compare``, ``state.probe_pixel``...).
-for _part, _cls in SUB_STATES.items():
-    for _name in _cls.__dataclass_fields__:
-        setattr(AppState, _name, _In(_part, _name))
-del _part, _cls, _name
+# Remaining for the pipelines merge (see REMAINING_FLAT_NAMES).
+for _name, (_part, _field) in REMAINING_FLAT_NAMES.items():
+    setattr(AppState, _name, _In(_part, _field))
+del _name, _part, _field

@@ -203,7 +203,7 @@ def open_case(state, case) -> bool:
         state.error = f"gallery case '{case.name}': {exc}"
         return False
     state.replace_scene(scene, case.preset, new_file=True)
-    state.gallery_opened = case.name
+    state.studies.gallery_opened = case.name
     note = ""
     job = offline_job_of(case)
     if job:

@@ -9,6 +9,7 @@ Names follow the lecture (``Ia``, ``ka``, ``kd``, ``ks``, ``n``, ``Od``, ``Os``,
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass, field, fields
 from typing import Any
 
@@ -62,6 +63,10 @@ class Checked:
     (``Material: key 'kd': expected a number in [0, 1], got 1.5``) and the value stays as it
     was; a valid value is stored in canonical form (a list of three numbers becomes a tuple).
     Construction itself is not checked (the preset loader checks every key it sets).
+
+    Every object carries an edit stamp (``_stamp``; a copy keeps its original's): made anew at
+    construction and by every assignment that changes a value (a slider that writes back the
+    same value leaves it). :attr:`Scene.version` reads the stamps of the whole scene.
     """
 
     def __setattr__(self, name: str, value: Any) -> None:
@@ -72,10 +77,27 @@ class Checked:
                                                if "spec" in f.metadata}
             if name in specs:
                 value = _VALIDATE(type(self), name, value, type(self).__name__, name)
+            if _changes(self.__dict__.get(name, _MISSING), value):
+                object.__setattr__(self, "_stamp", next(_STAMPS))
         object.__setattr__(self, name, value)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "_checked", True)
+        object.__setattr__(self, "_stamp", next(_STAMPS))
+
+
+_STAMPS = itertools.count(1)   # edit stamps, unique in the process (next() is atomic)
+_MISSING = object()
+
+
+def _changes(old: Any, new: Any) -> bool:
+    """True unless ``new`` equals ``old`` (a value that cannot be compared is a change)."""
+    if old is new:
+        return False
+    try:
+        return bool(old != new)
+    except (TypeError, ValueError):  # e.g. numpy arrays
+        return True
 
 
 _SPECCED: dict[type, set[str]] = {}
@@ -245,6 +267,21 @@ class Scene(Checked):
 
     def material_of(self, obj: Object) -> Material:
         return self.materials[obj.material]
+
+    @property
+    def version(self) -> int:
+        """The scene's edit counter: it goes up once after any change to the scene or anything
+        in it (a validated assignment to a field of the scene, its camera, settings, a light, a
+        material or an object; a light, material or object added, removed or replaced), so a
+        viewer sees an edit that no one announced. Reading it changes nothing else; a copy
+        starts from the original's count."""
+        nodes = (self, self.camera, self.render, self.raytrace, self.radiosity, *self.lights,
+                 *self.materials.values(), *self.objects)
+        signature = (tuple(self.materials), tuple(getattr(n, "_stamp", id(n)) for n in nodes))
+        if signature != self.__dict__.get("_signature"):
+            object.__setattr__(self, "_signature", signature)
+            object.__setattr__(self, "_version", self.__dict__.get("_version", -1) + 1)
+        return self.__dict__["_version"]
 
     def active_lights(self) -> list[Light]:
         return [light for light in self.lights if light.enabled]

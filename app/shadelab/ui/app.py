@@ -9,7 +9,6 @@ snapshots, autosave, window title).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Callable
 
 import numpy as np
@@ -28,13 +27,18 @@ from shadelab.lab.state import (
 )
 from shadelab.ui import (
     compare_view,
+    equation_panel,
     gizmos,
     layout,
+    lights_panel,
+    materials_panel,
+    objects_panel,
     panels,
     pipeline_viewport,
     pipelines,
     presenter,
     radiosity_view,
+    scene_panel,
 )
 from shadelab.ui.followups import FollowUps, ViewerOptions, write_window_screenshot
 from shadelab.ui.frame import guarded
@@ -62,8 +66,9 @@ def _set(attr: str, value) -> Callable[[AppState], None]:
 
 
 def _toggle(attr: str) -> Callable[[AppState], None]:
+    """A shortcut that switches the ViewState field ``attr`` (``state.view``)."""
     def action(state: AppState) -> None:
-        setattr(state, attr, not getattr(state, attr))
+        setattr(state.view, attr, not getattr(state.view, attr))
     return action
 
 
@@ -73,17 +78,8 @@ def _toggle_blinn(state: AppState) -> None:
     state.mark_edited()
 
 
-def _screenshot(state: AppState) -> None:
-    name = state.scene.name or "scene"
-    folder = Path(state.screenshot_dir)
-    index = 1
-    while (folder / f"shadelab-{name}-{index:03d}.png").exists():
-        index += 1
-    state.screenshot_requested = str(folder / f"shadelab-{name}-{index:03d}.png")
-
-
 def _save(state: AppState) -> None:
-    panels.save_here(state)
+    scene_panel.save_here(state)
 
 
 K = imgui.Key
@@ -101,7 +97,7 @@ SHORTCUTS = (
     (K.c, "C", "compare 2x2", _toggle("compare")),
     (K.d, "D", "difference heat map (compare)", _toggle("diff_enabled")),
     (K.r, "R", "reset view", AppState.reset_view),
-    (K.s, "S", "screenshot of the viewport", _screenshot),
+    (K.s, "S", "screenshot of the viewport", scene_panel.screenshot),
     (K.f, "F", "presenter mode (large fonts)", _toggle("presenter")),
     (K.h, "H", "this help", _toggle("show_help")),
     (K.f1, "F1", "this help", _toggle("show_help")),
@@ -127,7 +123,7 @@ def handle_shortcuts(state: AppState) -> None:
 
 
 def draw_help_overlay(state: AppState) -> None:
-    if not state.show_help:
+    if not state.view.show_help:
         return
     imgui.set_next_window_bg_alpha(0.9)
     expanded, opened = imgui.begin("Help", True, imgui.WindowFlags_.always_auto_resize)
@@ -139,7 +135,7 @@ def draw_help_overlay(state: AppState) -> None:
             imgui.text(f"{keys:>20}  {what}")
     imgui.end()
     if not opened:
-        state.show_help = False
+        state.view.show_help = False
 
 
 # ---------------------------------------------------------------- the viewer
@@ -147,6 +143,11 @@ def draw_help_overlay(state: AppState) -> None:
 
 @dataclass
 class Viewer:
+    """The viewer window: the panels' AppState and the GL side (viewport, GPU requests).
+
+    Implements :class:`shadelab.ui.viewport_host.ViewportHost`, what the viewport layouts
+    (compare grid, presenter, pipelines) may ask of it."""
+
     state: AppState
     options: ViewerOptions
     viewport: object = None            # shadelab.ui.viewport.Viewport, made in post_init
@@ -174,7 +175,7 @@ class Viewer:
         self.gpu.flush(self.state.gpu)  # attached: panels may queue work from the first frame
         from shadelab.gl.target import max_msaa_samples
 
-        self.state.msaa_limit = max_msaa_samples(self.viewport.ctx)
+        self.state.view.msaa_limit = max_msaa_samples(self.viewport.ctx)
         from shadelab.ui.dialogs import install_drop_callback
 
         install_drop_callback()
@@ -182,11 +183,12 @@ class Viewer:
                              hello_imgui.get_runner_params().docking_params.dockable_windows)
 
     def before_exit(self) -> None:
-        self.state.job.shutdown()
-        if self.state.pipeline_view is not None and self.state.pipeline_view.runner is not None:
-            self.state.pipeline_view.runner.shutdown()
-        if self.state.study is not None:
-            self.state.study.shutdown()
+        self.state.offline.runner.shutdown()
+        pipeline_view = self.state.view.pipeline_view
+        if pipeline_view is not None and pipeline_view.runner is not None:
+            pipeline_view.runner.shutdown()
+        if self.state.studies.run is not None:
+            self.state.studies.run.shutdown()
         if self.options.autosave:
             self.autosave(self.state, force=True)
         if self.options.bench_json:
@@ -207,10 +209,10 @@ class Viewer:
         # the caption gets its own band under the image: it never hides the scene
         band = presenter.caption_band(state, avail.x)
         size = (max(int(avail.x), 16), max(int(avail.y - band) - 4, 16))
-        if size != state.viewport_size and state.probe_pixel is not None:
-            state.probe_requested = True  # the same pixel shows another point now
-        state.viewport_size = size
-        if state.compare:
+        if size != state.view.viewport_size and state.probe.pixel is not None:
+            state.probe.requested = True  # the same pixel shows another point now
+        state.view.viewport_size = size
+        if state.view.compare:
             compare_view.draw_compare(self, size)
         else:
             self.draw_main(size)
@@ -218,14 +220,14 @@ class Viewer:
         # rect can hide them
         presenter.draw_viewport_extras(state, origin, size, self.recorder.redrawn, band)
         presenter.draw_lesson_buttons(state, origin, size, band)
-        if not state.compare:
+        if not state.view.compare:
             gizmos.draw(state, origin, size)
         self.recorder.viewport_shown = True
         if state.error:
             imgui.set_cursor_pos(imgui.ImVec2(12, 40))
             imgui.text_colored(panels.ERROR_COLOR, f"Error: {state.error}")
 
-    def _image_with_input(self, texture, size: tuple[int, int]) -> tuple[float, float] | None:
+    def image_with_input(self, texture, size: tuple[int, int]) -> tuple[float, float] | None:
         """Show the texture; handle orbit/pan/zoom; return the clicked pixel, if any."""
         state = self.state
         origin = imgui.get_cursor_screen_pos()
@@ -259,19 +261,24 @@ class Viewer:
             return mouse.x - origin.x, mouse.y - origin.y
         return None
 
+    # Remaining for the pipelines merge: ui/pipeline_viewport.py still calls the old name.
+    _image_with_input = image_with_input
+
     def frame_key(self, size: tuple[int, int]) -> tuple:
-        """Everything the viewport image depends on; an unchanged key reuses the last image."""
-        s = self.state
-        probe_id = s.probe_version
-        return (repr(s.scene), size, s.compare, s.diff_enabled, s.diff_pair, s.diff_scale,
-                s.show_wireframe, s.show_normals, s.normal_length, probe_id, s.overlay_version,
-                s.show_radiosity, s.tonemap, s.show_clipping, presenter.line_px(s), s.antialias,
-                s.msaa)
+        """Everything the viewport image depends on; an unchanged key reuses the last image.
+
+        The scene counts by its edit counter (``Scene.version``: any change in it, announced by
+        ``mark_edited`` or not) and by which scene it is (``scene_version``: loads, undo)."""
+        s, v = self.state, self.state.view
+        return (id(s.scene), s.scene_version, s.scene.version, size, v.compare, v.diff_enabled,
+                v.diff_pair, v.diff_scale, v.show_wireframe, v.show_normals, v.normal_length,
+                s.probe.version, s.offline.overlay_version, s.offline.show_radiosity, v.tonemap,
+                v.show_clipping, presenter.line_px(s), v.antialias, v.msaa)
 
     def unchanged(self, size: tuple[int, int]) -> bool:
         """True when the last image is still right (idle frames only redraw the GUI)."""
         key = self.frame_key(size)
-        redraw = self.recorder.force_redraw or self.state.probe_requested \
+        redraw = self.recorder.force_redraw or self.state.probe.requested \
             or bool(self.state.screenshot_requested) or key != self._frame_key
         self._frame_key = key
         self.recorder.redrawn = redraw
@@ -284,46 +291,47 @@ class Viewer:
             return
         display_size, size = size, self.render_size(size)
         if "main" in vp.panes and self.unchanged(size):
-            self._handle_click(self._image_with_input(vp.panes["main"].display, display_size),
+            self._handle_click(self.image_with_input(vp.panes["main"].display, display_size),
                                display_size)
             return
         # --- PASS 1-2: the scene into the float target (the Renderer's passes), or the solved
         # radiosity meshes, Gouraud-interpolated (view-independent: walk around them)
-        radiosity = state.show_radiosity and state.radiosity_soup is not None
+        radiosity = state.offline.show_radiosity and state.offline.radiosity_soup is not None
         if radiosity:
             pane = vp.pane("main", size, self.samples())
-            vp.draw_colored_triangles(pane, scene, state.radiosity_soup)
+            vp.draw_colored_triangles(pane, scene, state.offline.radiosity_soup)
         else:
             pane = vp.draw_scene("main", scene, size, scene.render.shading, scene.render.specular,
                                  self.samples())
         # --- PASS 3: the probe reads the GPU value before any overlay is drawn
-        if state.probe_requested:
+        if state.probe.requested:
             update_probe(state, vp, size, display_size, self.samples())
         # --- PASS 4: overlays (wireframe, normal glyphs, probe arrows)
         exposure = scene.render.exposure
         meshes = scene_meshes(scene)
         vp.line_width = presenter.line_px(state) * size[0] / max(display_size[0], 1)
-        if state.show_wireframe:
+        if state.view.show_wireframe:
             vp.draw_lines(pane, self.cached_lines("wire", meshes), exposure)
-        if state.show_normals:
+        if state.view.show_normals:
             vp.draw_lines(pane, self.cached_lines("normals", meshes), exposure)
-        if state.probe is not None:
+        if state.probe.result is not None:
             length = 0.12 * overlays.scene_diagonal(meshes)
-            vp.draw_lines(pane, overlays.probe_arrows(state.probe, length), exposure,
+            vp.draw_lines(pane, overlays.probe_arrows(state.probe.result, length), exposure,
                           depth_test=False)
-        if state.ray_tree is not None:
-            lines = overlays.ray_tree_lines(state.ray_tree, overlays.scene_diagonal(meshes))
+        if state.offline.ray_tree is not None:
+            lines = overlays.ray_tree_lines(state.offline.ray_tree, overlays.scene_diagonal(meshes))
             vp.draw_lines(pane, lines, exposure, depth_test=False)
         # --- PASS 5: exposure, tone map + sRGB for display
-        texture = vp.present(pane, exposure, tonemap=state.tonemap, clipping=state.show_clipping)
+        texture = vp.present(pane, exposure, tonemap=state.view.tonemap,
+                             clipping=state.view.show_clipping)
         if state.screenshot_requested:
             write_viewport_screenshot(state, vp, state.screenshot_requested)
             state.screenshot_requested = ""
-        self._handle_click(self._image_with_input(texture, display_size), display_size)
+        self._handle_click(self.image_with_input(texture, display_size), display_size)
 
     def samples(self) -> int:
         """MSAA samples of the scene pass: the Display panel's choice, within the GL's limit."""
-        return max(1, min(self.state.msaa, self.state.msaa_limit or 1))
+        return max(1, min(self.state.view.msaa, self.state.view.msaa_limit or 1))
 
     def interacting(self) -> bool:
         """A slider or the camera is being dragged right now."""
@@ -332,29 +340,29 @@ class Viewer:
 
     def render_size(self, size: tuple[int, int]) -> tuple[int, int]:
         """The scene's resolution: the viewport's times the render scale (lower mid-drag)."""
-        scale = self.state.render_scale
+        scale = self.state.view.render_scale
         if self.interacting():
-            scale = min(scale, self.state.interactive_scale)
-        scale *= self.state.antialias  # supersampled, filtered down by the display texture
+            scale = min(scale, self.state.view.interactive_scale)
+        scale *= self.state.view.antialias  # supersampled, filtered down by the display texture
         return max(int(size[0] * scale), 8), max(int(size[1] * scale), 8)
 
     def _handle_click(self, clicked, size: tuple[int, int]) -> None:
         if clicked is not None:
             x, y = int(clicked[0]), int(clicked[1])
             if 0 <= x < size[0] and 0 <= y < size[1]:
-                self.state.probe_pixel, self.state.probe_requested = (x, y), True
+                self.state.probe.pixel, self.state.probe.requested = (x, y), True
 
     def cached_lines(self, kind: str, meshes) -> np.ndarray:
         scene, state = self.state.scene, self.state
         key = (kind, tuple(geometry_key(o, scene.base_dir) for o in scene.objects),
-               scene.render.shading, state.normal_length)
+               scene.render.shading, state.view.normal_length)
         if key not in self._line_cache:
             if len(self._line_cache) > 8:
                 self._line_cache.clear()
             if kind == "wire":
                 lines = overlays.wireframe(meshes)
             else:
-                length = state.normal_length * overlays.scene_diagonal(meshes)
+                length = state.view.normal_length * overlays.scene_diagonal(meshes)
                 lines = overlays.normal_glyphs(meshes, length, scene.render.shading)
             self._line_cache[key] = lines
         return self._line_cache[key]
@@ -385,12 +393,12 @@ class Viewer:
         """Shortcuts, undo snapshots, autosave, title, scripted exit."""
         state = self.state
         handle_shortcuts(state)
-        if state.lesson is not None and state.lesson.step is None \
+        if state.walk.lesson is not None and state.walk.lesson.step is None \
                 and not lesson.go_to(state, 0):  # a lesson just opened (Open, drop): step 1
-            state.lesson = None                  # (its error is on the status line)
+            state.walk.lesson = None                  # (its error is on the status line)
         presenter.end_frame(self)
         draw_help_overlay(state)
-        scale = PRESENTER_SCALE if state.presenter else 1.0
+        scale = PRESENTER_SCALE if state.view.presenter else 1.0
         style = imgui.get_style()
         if style.font_scale_main != scale:  # only on change: a new scale re-bakes glyphs
             style.font_scale_main = scale
@@ -406,8 +414,8 @@ class Viewer:
         state.frame += 1
         if state.frame == WARM_JOBS_AT_FRAME and not (self.options.frames
                                                       or self.options.test_function) \
-                and state.job.worker is not None:
-            state.job.worker.warm()  # after start-up: the first job then starts at once
+                and state.offline.runner.worker is not None:
+            state.offline.runner.worker.warm()  # after start-up: the first job then starts at once
         if self.options.bench_json and self.options.frames:
             self.recorder.set_phase(state.frame, self.options.frames)
         if self.followups.end_frame(state):  # --frames done (after --job, --study...)
@@ -454,13 +462,13 @@ def _docking(viewer: Viewer) -> hello_imgui.DockingParams:
     ]
     p = viewer.panel
     params.dockable_windows = [
-        window("Scene", "LeftSpace", p(_scene_panel)),
-        window("Lights", "LeftSpace", p(panels.draw_lights_panel)),
-        window("Materials", "LeftSpace", p(panels.draw_materials_panel)),
-        window("Objects", "LeftSpace", p(panels.draw_objects_panel)),
+        window("Scene", "LeftSpace", p(scene_panel.draw_scene_panel)),
+        window("Lights", "LeftSpace", p(lights_panel.draw_lights_panel)),
+        window("Materials", "LeftSpace", p(materials_panel.draw_materials_panel)),
+        window("Objects", "LeftSpace", p(objects_panel.draw_objects_panel)),
         window("Viewport", "MainDockSpace",
                lambda: guarded(viewer.draw_viewport_window, "viewport", viewer.report_error)),
-        window("Equation & probe", "RightSpace", p(panels.draw_equation_panel)),
+        window("Equation & probe", "RightSpace", p(equation_panel.draw_equation_panel)),
         window("Studies", "RightSpace", p(draw_studies_panel)),
         window("Failure gallery", "RightSpace", p(draw_gallery_panel)),
         window("Offline render", "RightBottom", p(draw_offline_panel)),
@@ -476,28 +484,6 @@ def _docking(viewer: Viewer) -> hello_imgui.DockingParams:
     return params
 
 
-def _scene_panel(state: AppState) -> bool:
-    panels.draw_file_panel(state)
-    imgui.separator()
-    edited = panels.draw_render_panel(state)
-    imgui.separator()
-    panels.draw_compare_panel(state)
-    _, state.presenter = imgui.checkbox("Presenter mode (F)", state.presenter)
-    imgui.same_line()
-    _, state.show_help = imgui.checkbox("Help (H)", state.show_help)
-    if imgui.button("Screenshot (S)"):
-        _screenshot(state)
-    imgui.same_line()
-    _, state.legend_in_screenshot = imgui.checkbox("with legend", state.legend_in_screenshot)
-    if imgui.button("Reset view (R)"):
-        state.reset_view()
-    _, state.render_scale = panels._slider("render scale", state.render_scale, 0.25, 1.0)
-    _, state.interactive_scale = panels._slider("while dragging", state.interactive_scale,
-                                                0.25, 1.0)
-    edited |= presenter.draw_display_panel(state)
-    return edited
-
-
 def runner_params(viewer: Viewer) -> hello_imgui.RunnerParams:
     params = hello_imgui.RunnerParams()
     params.app_window_params.window_title = viewer.state.title()
@@ -505,7 +491,7 @@ def runner_params(viewer: Viewer) -> hello_imgui.RunnerParams:
     if viewer.options.fullscreen:
         params.app_window_params.window_geometry.full_screen_mode = \
             hello_imgui.FullScreenMode.full_monitor_resolution
-        viewer.state.fullscreen = True
+        viewer.state.view.fullscreen = True
         presenter.mark_fullscreen_applied()
     elif viewer.options.maximized:
         params.app_window_params.window_geometry.window_size_state = \
@@ -554,8 +540,8 @@ def run_viewer(state: AppState, options: ViewerOptions) -> int:
 
 def _run(viewer: Viewer, state: AppState, options: ViewerOptions) -> int:
     if options.test_function is None:
-        state.pipeline = options.pipeline or state.pipeline
-        if state.pipeline in pipelines.OFFLINE:
+        state.view.pipeline = options.pipeline or state.view.pipeline
+        if state.view.pipeline in pipelines.OFFLINE:
             pipelines.warm(state)  # an offline view at start: its process spawns at once
         else:  # else once the first frame is up: on 2 cores its imports delay that frame
             viewer.warm_after_first_frame = True

@@ -8,15 +8,16 @@ from imgui_bundle import imgui
 
 from shadelab.lab import camera_control
 from shadelab.lab.state import COMPARE_LABELS, COMPARE_VIEWS, AppState
+from shadelab.ui.viewport_host import ViewportHost
 
 
-def draw_compare(viewer, size: tuple[int, int]) -> None:
+def draw_compare(viewer: ViewportHost, size: tuple[int, int]) -> None:
     """The 2x2 grid of shading modes under one camera, or the difference heat map of two of
     them with both as thumbnails (the D key)."""
     state, vp = viewer.state, viewer.viewport
     scene = state.scene
     # Four quadrants; with the heat map, the map takes 70% of the width at full height.
-    if state.diff_enabled:
+    if state.view.diff_enabled:
         half = (max(int(size[0] * 0.7), 8), max(size[1], 8))
     else:
         half = (max(size[0] // 2, 8), max(size[1] // 2, 8))
@@ -26,17 +27,17 @@ def draw_compare(viewer, size: tuple[int, int]) -> None:
     else:
         panes = [vp.draw_scene(f"compare{i}", scene, half, shading, specular, viewer.samples())
                  for i, (shading, specular) in enumerate(COMPARE_VIEWS)]
-    if state.diff_enabled:
-        a, b = state.diff_pair
+    if state.view.diff_enabled:
+        a, b = state.view.diff_pair
         diff = vp.pane("diff", half)
-        vp.present(diff, exposure, panes[a], panes[b], state.diff_scale)
+        vp.present(diff, exposure, panes[a], panes[b], state.view.diff_scale)
         origin = imgui.get_cursor_screen_pos()
         texture = diff.display
-        viewer._image_with_input(texture, half)
+        viewer.image_with_input(texture, half)
         draw = imgui.get_window_draw_list()
         draw.add_text(imgui.ImVec2(origin.x + 6, origin.y + 4), 0xFFFFFFFF,
                       f"|{COMPARE_LABELS[a]} - {COMPARE_LABELS[b]}| x exposure, "
-                      f"full red = {state.diff_scale:.3g}")
+                      f"full red = {state.view.diff_scale:.3g}")
         imgui.same_line()
         imgui.begin_group()
         thumb_w = max(size[0] - half[0] - 12, 8)
@@ -51,7 +52,7 @@ def draw_compare(viewer, size: tuple[int, int]) -> None:
         return
     origin = imgui.get_cursor_screen_pos()
     for pane in panes:
-        vp.present(pane, exposure, tonemap=state.tonemap, clipping=state.show_clipping)
+        vp.present(pane, exposure, tonemap=state.view.tonemap, clipping=state.view.show_clipping)
     draw = imgui.get_window_draw_list()
     for i, pane in enumerate(panes):
         x = origin.x + (i % 2) * half[0]

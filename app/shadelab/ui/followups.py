@@ -46,8 +46,8 @@ def open_gallery_case(state: AppState, name: str) -> None:
     if name not in names:
         state.error = f"--gallery '{name}': expected one of {', '.join(names)}"
         return
-    state.gallery_index = names.index(name)
-    open_case(state, GALLERY[state.gallery_index])
+    state.studies.gallery_index = names.index(name)
+    open_case(state, GALLERY[state.studies.gallery_index])
 
 
 @dataclass
@@ -60,7 +60,7 @@ class FollowUps:
         """Once the window (and its GL) is up: the start-up requests of the command line."""
         options = self.options
         if options.probe is not None:
-            state.probe_pixel, state.probe_requested = options.probe, True
+            state.probe.pixel, state.probe.requested = options.probe, True
         if options.focus:
             from shadelab.ui.layout import focus_windows
 
@@ -82,15 +82,16 @@ class FollowUps:
         """A job, pipeline or study the command line started is not done yet (``--frames``
         counts after it; the study's plot fits its axes over a few frames more)."""
         options = self.options
-        waiting = bool(options.job) and (state.job.running or not state.job.started
-                                         or state.job_version != state.job.version)
+        runner = state.offline.runner
+        waiting = bool(options.job) and (runner.running or not runner.started
+                                         or state.offline.version != runner.version)
         waiting = waiting or bool(options.pipeline and pipelines.busy(state))
-        if state.study is not None:
-            state.study.poll()  # also while the Studies tab is hidden
-            if options.study and not self.study_done_at and not state.study.running:
+        if state.studies.run is not None:
+            state.studies.run.poll()  # also while the Studies tab is hidden
+            if options.study and not self.study_done_at and not state.studies.run.running:
                 self.study_done_at = state.frame
             waiting = waiting or bool(options.study and (
-                state.study.running
+                state.studies.run.running
                 or state.frame < self.study_done_at + min(options.frames, 10)))
         return waiting
 
@@ -104,9 +105,9 @@ class FollowUps:
 
     def follow_up_job(self, state: AppState) -> None:
         """The command line's after-job requests: radiosity in the viewport, a ray tree."""
-        if self.options.show_radiosity and state.radiosity_soup is not None:
-            state.show_radiosity = True
-        if self.options.ray_tree is not None and state.job_scene is not None:
+        if self.options.show_radiosity and state.offline.radiosity_soup is not None:
+            state.offline.show_radiosity = True
+        if self.options.ray_tree is not None and state.offline.scene is not None:
             from shadelab.ui.offline import trace_tree
 
             trace_tree(state, self.options.ray_tree)

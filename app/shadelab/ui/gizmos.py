@@ -73,15 +73,15 @@ def pixel_size_at(state: AppState, point, height: int, width: int = 0) -> float:
 def draw(state: AppState, origin, size: tuple[int, int]) -> bool:
     """Glyphs for every light and the ImGuizmo of the selected one; True when it moved."""
     global _using
-    if not state.show_gizmos or not state.scene.lights:
+    if not state.view.show_gizmos or not state.scene.lights:
         _using = False
         return False
     project, view, proj = projector(state, size)
     draw_list = imgui.get_window_draw_list()
-    scale = 1.8 if state.presenter else 1.0
+    scale = 1.8 if state.view.presenter else 1.0
     cam = state.scene.camera
     span = float(np.linalg.norm(np.subtract(cam.target, cam.eye))) or 1.0
-    selected = min(max(state.gizmo_light, 0), len(state.scene.lights) - 1)
+    selected = min(max(state.view.gizmo_light, 0), len(state.scene.lights) - 1)
     for i, light in enumerate(state.scene.lights):
         color = (SELECTED_COLOR if i == selected else GLYPH_COLOR) if light.enabled \
             else GLYPH_OFF_COLOR
@@ -96,7 +96,7 @@ def draw(state: AppState, origin, size: tuple[int, int]) -> bool:
         return False
     GIZMO.set_drawlist(draw_list)
     GIZMO.set_rect(origin.x, origin.y, float(size[0]), float(size[1]))
-    GIZMO.set_gizmo_size_clip_space(GIZMO_SIZE * (1.3 if state.presenter else 1.0))
+    GIZMO.set_gizmo_size_clip_space(GIZMO_SIZE * (1.3 if state.view.presenter else 1.0))
     matrix = np.eye(4)
     matrix[:3, 3] = light.position
     object_matrix = column_major(matrix)
@@ -174,10 +174,10 @@ def draw_selector(state: AppState) -> None:
     if not lights:
         return
     names = [light.name or f"light {i}" for i, light in enumerate(lights)]
-    index = min(max(state.gizmo_light, 0), len(lights) - 1)
-    _, state.gizmo_light = imgui.combo("gizmo moves", index, names)
+    index = min(max(state.view.gizmo_light, 0), len(lights) - 1)
+    _, state.view.gizmo_light = imgui.combo("gizmo moves", index, names)
     from shadelab.ui.layout import same_line_if_fits
 
     if same_line_if_fits("show", radio=True):
         imgui.same_line()
-    _, state.show_gizmos = imgui.checkbox("show##gizmos", state.show_gizmos)
+    _, state.view.show_gizmos = imgui.checkbox("show##gizmos", state.view.show_gizmos)

@@ -12,6 +12,7 @@ from imgui_bundle import hello_imgui, imgui
 
 from shadelab.lab.state import AppState
 from shadelab.ui.layout import same_line_if_fits
+from shadelab.ui.viewport_host import ViewportHost
 
 PRESENTER_SCALE = 1.8          # font scale of presenter mode (ui/app.py applies it)
 LINE_PX = 1.5                  # overlay line width at font scale 1, pixels
@@ -25,24 +26,24 @@ PRESENTER_WINDOW = "##presenter viewport"
 
 def line_px(state: AppState) -> float:
     """Overlay line width on screen, pixels: grows with the presenter scale."""
-    if state.line_width > 0:
-        return state.line_width
-    return PRESENTER_LINE_PX if state.presenter else LINE_PX
+    if state.view.line_width > 0:
+        return state.view.line_width
+    return PRESENTER_LINE_PX if state.view.presenter else LINE_PX
 
 
 def font_scale(state: AppState) -> float:
-    return PRESENTER_SCALE if state.presenter else 1.0
+    return PRESENTER_SCALE if state.view.presenter else 1.0
 
 
 # ---------------------------------------------------------------- shortcut actions
 
 
 def toggle_panels(state: AppState) -> None:
-    state.hide_panels = not state.hide_panels
+    state.view.hide_panels = not state.view.hide_panels
 
 
 def toggle_fullscreen(state: AppState) -> None:
-    state.fullscreen = not state.fullscreen
+    state.view.fullscreen = not state.view.fullscreen
 
 
 # ---------------------------------------------------------------- fullscreen
@@ -53,18 +54,18 @@ _windowed_geometry: tuple[int, int, int, int] | None = None
 
 
 def apply_fullscreen(state: AppState) -> None:
-    """Switch the GLFW window to the monitor's resolution and back when ``state.fullscreen``
+    """Switch the GLFW window to the monitor's resolution and back when ``state.view.fullscreen``
     changed (the window's monitor: the one under its centre)."""
     global _applied_fullscreen, _windowed_geometry
-    if state.fullscreen == _applied_fullscreen:
+    if state.view.fullscreen == _applied_fullscreen:
         return
-    _applied_fullscreen = state.fullscreen
+    _applied_fullscreen = state.view.fullscreen
     try:
         import glfw
         from imgui_bundle import glfw_utils
 
         window = glfw_utils.glfw_window_hello_imgui()
-        if state.fullscreen:
+        if state.view.fullscreen:
             x, y = glfw.get_window_pos(window)
             w, h = glfw.get_window_size(window)
             _windowed_geometry = (x, y, w, h)
@@ -75,7 +76,7 @@ def apply_fullscreen(state: AppState) -> None:
         else:
             x, y, w, h = _windowed_geometry or (40, 40, 1600, 900)
             glfw.set_window_monitor(window, None, x, y, w, h, 0)
-        state.status = "fullscreen" if state.fullscreen else "windowed"
+        state.status = "fullscreen" if state.view.fullscreen else "windowed"
     except Exception as exc:  # no GLFW window (a mock backend): say so, keep running
         state.error = f"fullscreen: {exc}"
 
@@ -105,21 +106,21 @@ def apply_panel_visibility(state: AppState) -> None:
     """Tab: every dock window hidden (the viewport is drawn in a window of its own)."""
     global _hidden_labels
     windows = hello_imgui.get_runner_params().docking_params.dockable_windows
-    if state.hide_panels and not _hidden_labels:
+    if state.view.hide_panels and not _hidden_labels:
         _hidden_labels = [w.label for w in windows if w.is_visible]
         for w in windows:
             w.is_visible = False
-    elif not state.hide_panels and _hidden_labels:
+    elif not state.view.hide_panels and _hidden_labels:
         for w in windows:
             if w.label in _hidden_labels:
                 w.is_visible = True
         _hidden_labels = []
 
 
-def draw_presenter_viewport(viewer) -> None:
+def draw_presenter_viewport(viewer: ViewportHost) -> None:
     """With the panels hidden: the viewport over the whole window."""
     state = viewer.state
-    if not state.hide_panels:
+    if not state.view.hide_panels:
         return
     vp = imgui.get_main_viewport()
     imgui.set_next_window_pos(vp.work_pos)
@@ -184,11 +185,12 @@ def apply_layout(state: AppState) -> str:
 
 def caption_text(state: AppState) -> str:
     """The lesson step's caption, or (panels hidden) the current equation and mode."""
-    if state.lesson is not None and state.lesson.step is not None:
-        return state.lesson.caption()
-    if not state.hide_panels:
+    if state.walk.lesson is not None and state.walk.lesson.step is not None:
+        return state.walk.lesson.caption()
+    if not state.view.hide_panels:
         return ""
-    from shadelab.ui.panels import EQUATION, EQUATION_BLINN, SHADING_LABELS
+    from shadelab.ui.equation_panel import EQUATION, EQUATION_BLINN
+    from shadelab.ui.panels import SHADING_LABELS
 
     render = state.scene.render
     equation = EQUATION_BLINN if render.specular == "blinn" else EQUATION
@@ -244,15 +246,15 @@ def fps_text(redrawn: bool) -> str:
 def readout_width(state: AppState) -> float:
     """Screen width the fps readout takes at the viewport's top right (0 when hidden): the
     pipeline status line wraps before it instead of running under it."""
-    return imgui.calc_text_size(fps_text(True)).x + 24.0 if state.show_fps else 0.0
+    return imgui.calc_text_size(fps_text(True)).x + 24.0 if state.view.show_fps else 0.0
 
 
 def caption_scale(state: AppState) -> float:
-    return 1.4 if state.lesson is not None else 1.0
+    return 1.4 if state.walk.lesson is not None else 1.0
 
 
 def lesson_running(state: AppState) -> bool:
-    return state.lesson is not None and state.lesson.step is not None
+    return state.walk.lesson is not None and state.walk.lesson.step is not None
 
 
 def caption_band(state: AppState, width: float) -> float:
@@ -293,11 +295,11 @@ def draw_viewport_extras(state: AppState, origin, size, redrawn: bool,
     compare at the bottom right, clear of the panes' labels) and the caption in the ``band``
     pixels under it (over the image's bottom when no band was kept)."""
     draw = imgui.get_window_draw_list()
-    if state.show_fps:
+    if state.view.show_fps:
         text = fps_text(redrawn)
         width = imgui.calc_text_size(text).x
         line = imgui.get_font_size()
-        y = origin.y + size[1] - line - 6 if state.compare else origin.y + 4
+        y = origin.y + size[1] - line - 6 if state.view.compare else origin.y + 4
         pos = imgui.ImVec2(origin.x + size[0] - width - 8, y)
         draw.add_rect_filled(imgui.ImVec2(pos.x - 4, pos.y - 2),
                              imgui.ImVec2(pos.x + width + 4, pos.y + line + 2), 0x90000000)
@@ -323,17 +325,18 @@ def draw_display_panel(state: AppState) -> bool:
     for name in TONEMAPS:
         if same_line_if_fits(TONEMAP_LABELS[name], radio=True):
             imgui.same_line()
-        if imgui.radio_button(TONEMAP_LABELS[name], state.tonemap == name):
-            state.tonemap = name
-    _, state.show_clipping = imgui.checkbox("Show clipped pixels (stripes)", state.show_clipping)
+        if imgui.radio_button(TONEMAP_LABELS[name], state.view.tonemap == name):
+            state.view.tonemap = name
+    _, state.view.show_clipping = imgui.checkbox("Show clipped pixels (stripes)",
+                                                 state.view.show_clipping)
     draw_antialias_choice(state)
-    _, state.show_fps = imgui.checkbox("fps readout", state.show_fps)
-    _, state.line_width = imgui.slider_float("line width", state.line_width, 0.0, 8.0,
-                                             "%.1f px" if state.line_width > 0 else "auto")
+    _, state.view.show_fps = imgui.checkbox("fps readout", state.view.show_fps)
+    _, state.view.line_width = imgui.slider_float("line width", state.view.line_width, 0.0, 8.0,
+                                             "%.1f px" if state.view.line_width > 0 else "auto")
     imgui.set_item_tooltip("0: by the presenter scale (>= 3 px in presenter mode)")
-    _, state.show_gizmos = imgui.checkbox("Light gizmos", state.show_gizmos)
-    _, state.hide_panels = imgui.checkbox("Viewport only (Tab)", state.hide_panels)
-    _, state.fullscreen = imgui.checkbox("Fullscreen (F11)", state.fullscreen)
+    _, state.view.show_gizmos = imgui.checkbox("Light gizmos", state.view.show_gizmos)
+    _, state.view.hide_panels = imgui.checkbox("Viewport only (Tab)", state.view.hide_panels)
+    _, state.view.fullscreen = imgui.checkbox("Fullscreen (F11)", state.view.fullscreen)
     # the camera's framing (scene fields): fov_y, and the narrowest aspect kept side to side
     from shadelab.ui.render_panel import float_slider
 
@@ -356,17 +359,17 @@ def antialias_choices(limit: int) -> list[tuple[str, int, int]]:
 def draw_antialias_choice(state: AppState) -> None:
     """Anti-aliasing: off, MSAA 2 / 4 / 8 where the GL allows, or 2x2 supersampling."""
     imgui.text("Anti-aliasing")
-    for label, samples, factor in antialias_choices(state.msaa_limit):
+    for label, samples, factor in antialias_choices(state.view.msaa_limit):
         if same_line_if_fits(label, radio=True):
             imgui.same_line()
-        if imgui.radio_button(label, (state.msaa, state.antialias) == (samples, factor)):
-            state.msaa, state.antialias = samples, factor
+        if imgui.radio_button(label, (state.view.msaa, state.view.antialias) == (samples, factor)):
+            state.view.msaa, state.view.antialias = samples, factor
 
 
 # ---------------------------------------------------------------- per frame
 
 
-def end_frame(viewer) -> None:
+def end_frame(viewer: ViewportHost) -> None:
     """Fullscreen, panel visibility, dialogs, drops, stale overlays, panel focus."""
     from shadelab.ui import dialogs
 
@@ -379,12 +382,12 @@ def end_frame(viewer) -> None:
     dialogs.take_dropped(state)
     dialogs.draw_discard_question(state)
     drop_stale_overlays(state)
-    if state.focus_request:
+    if state.walk.focus_request:
         from shadelab.ui.layout import focus_windows
 
         focus_windows(hello_imgui.get_runner_params().docking_params.dockable_windows,
-                      state.focus_request)
-        state.focus_request = ""
+                      state.walk.focus_request)
+        state.walk.focus_request = ""
 
 
 _last_version: int = -1
@@ -397,16 +400,17 @@ def drop_stale_overlays(state: AppState) -> None:
     if state.scene_version == _last_version:
         return
     _last_version = state.scene_version
-    if state.job_scene is None or (state.ray_tree is None and state.radiosity_soup is None):
+    offline = state.offline
+    if offline.scene is None or (offline.ray_tree is None and offline.radiosity_soup is None):
         return
     from shadelab.scene.preset import scene_to_dict
 
-    now, then = scene_to_dict(state.scene), scene_to_dict(state.job_scene)
+    now, then = scene_to_dict(state.scene), scene_to_dict(state.offline.scene)
     now.pop("camera", None)
     then.pop("camera", None)
     if now != then:
-        state.ray_tree = state.ray_tree_pixel = None
-        state.radiosity_soup = None
-        state.show_radiosity = False
-        state.overlay_version += 1
+        state.offline.ray_tree = state.offline.ray_tree_pixel = None
+        state.offline.radiosity_soup = None
+        state.offline.show_radiosity = False
+        state.offline.overlay_version += 1
         state.status = "the scene changed: ray tree and radiosity solution cleared (run again)"

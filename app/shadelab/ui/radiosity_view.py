@@ -248,7 +248,7 @@ def draw_panel(state) -> bool:
         return False
     n = len(view.patches)
     step_rows(state, view)
-    pv = state.pipeline_view
+    pv = state.view.pipeline_view
     shooter = None if pv is None else pv.stats.get("shooter_index")
     _, view.follow = imgui.checkbox("follow the shooting patch", view.follow)
     if same_line_if_fits("patch-id view (viewport)", radio=True):

@@ -31,9 +31,9 @@ FRONT_COLOR = imgui.ImVec4(0.85, 0.85, 0.85, 0.9)
 
 
 def study_run(state: AppState) -> StudyRun:
-    if state.study is None:
-        state.study = StudyRun()
-    return state.study
+    if state.studies.run is None:
+        state.studies.run = StudyRun()
+    return state.studies.run
 
 
 def start_study(state: AppState, name: str, quick: bool = True) -> None:
@@ -44,7 +44,7 @@ def start_study(state: AppState, name: str, quick: bool = True) -> None:
     if name not in names:
         state.error = f"--study '{name}': expected one of {', '.join(names)}"
         return
-    state.study_index = names.index(name)
+    state.studies.index = names.index(name)
     study_run(state).start(name, quick)
 
 
@@ -131,8 +131,8 @@ def draw_studies_panel(state: AppState) -> bool:
     run = study_run(state)
     run.poll()
     labels = [f"{name}: {title}" for name, title in STUDIES]
-    _, state.study_index = imgui.combo("Study", state.study_index, labels)
-    name = STUDIES[state.study_index][0]
+    _, state.studies.index = imgui.combo("Study", state.studies.index, labels)
+    name = STUDIES[state.studies.index][0]
     imgui.begin_disabled(run.running)
     if imgui.button("Run (quick)"):
         start_study(state, name, quick=True)
@@ -167,15 +167,15 @@ def draw_studies_panel(state: AppState) -> bool:
         imgui.text("  chart:")
         for i, (key, _) in enumerate(tables):
             imgui.same_line()
-            if imgui.radio_button(f"{key}##chart", state.study_chart == i):
-                state.study_chart = i
-    state.study_chart = min(state.study_chart, len(tables) - 1)
-    table = tables[state.study_chart][1]
-    state.study_plotted = _draw_chart(table, front=table is result)
+            if imgui.radio_button(f"{key}##chart", state.studies.chart == i):
+                state.studies.chart = i
+    state.studies.chart = min(state.studies.chart, len(tables) - 1)
+    table = tables[state.studies.chart][1]
+    state.studies.plotted = _draw_chart(table, front=table is result)
     if study_front(result):
-        _, state.study_budget = imgui.slider_float(
-            "error budget", state.study_budget, 1e-5, 1.0, "%.2g", imgui.SliderFlags_.logarithmic)
-        _wrapped(auto_quality_line(result, state.study_budget), panels.OK_COLOR)
+        _, state.studies.budget = imgui.slider_float(
+            "error budget", state.studies.budget, 1e-5, 1.0, "%.2g", imgui.SliderFlags_.logarithmic)
+        _wrapped(auto_quality_line(result, state.studies.budget), panels.OK_COLOR)
     _draw_rows(table)
     for note in result.notes:
         _wrapped(note, panels.DIM_COLOR)
@@ -192,13 +192,14 @@ def draw_gallery_panel(state: AppState) -> bool:
 
     if imgui.begin_list_box("##cases", imgui.ImVec2(-1, 150)):
         for i, case in enumerate(GALLERY):
-            if imgui.selectable(f"{case.name}  ({case.method})", state.gallery_index == i)[0]:
-                state.gallery_index = i
+            selected = state.studies.gallery_index == i
+            if imgui.selectable(f"{case.name}  ({case.method})", selected)[0]:
+                state.studies.gallery_index = i
         imgui.end_list_box()
-    if not 0 <= state.gallery_index < len(GALLERY):
+    if not 0 <= state.studies.gallery_index < len(GALLERY):
         imgui.text_colored(panels.DIM_COLOR, "Select a case to see what fails and why.")
         return False
-    case = GALLERY[state.gallery_index]
+    case = GALLERY[state.studies.gallery_index]
     imgui.text_wrapped(case.name)
     overrides = " ".join(f"--set {o}" for o in case.overrides)
     _wrapped(f"preset {case.preset} {overrides}   method {case.method}", panels.DIM_COLOR)
@@ -211,13 +212,13 @@ def draw_gallery_panel(state: AppState) -> bool:
     job = offline_job_of(case)
     if job:
         imgui.same_line()
-        imgui.begin_disabled(state.job.running)
+        imgui.begin_disabled(state.offline.runner.running)
         if imgui.button("Run offline job") and open_case(state, case):
             start_job_by_label(state, job)
         imgui.end_disabled()
         _wrapped(f"shown by the {job} offline renderer (Offline render panel)",
                  panels.DIM_COLOR)
-    if state.gallery_opened == case.name and not state.error:
+    if state.studies.gallery_opened == case.name and not state.error:
         imgui.text_colored(panels.OK_COLOR, f"open: {state.scene.name or case.preset}, "
                            f"{state.scene.render.shading} shading")
     if state.error:

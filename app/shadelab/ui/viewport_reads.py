@@ -11,29 +11,29 @@ def update_probe(state: AppState, viewport, size: tuple[int, int],
                  display_size: tuple[int, int], samples: int = 1) -> None:
     """Recompute the probed pixel's terms (CPU reference) and read what the GPU drew.
 
-    ``state.probe_pixel`` is in viewport pixels; the scene may be rendered at another
+    ``state.probe.pixel`` is in viewport pixels; the scene may be rendered at another
     resolution (render scale), so the pixel is mapped to the rendered image first. With
     ``samples`` > 1 (MSAA) the scene is drawn again single-sampled to read the pixel.
     """
-    shown = state.probe_pixel
+    shown = state.probe.pixel
     if shown is None or not (0 <= shown[0] < display_size[0]
                              and 0 <= shown[1] < display_size[1]):
-        state.probe = None
-        state.probe_version += 1
+        state.probe.result = None
+        state.probe.version += 1
         return  # (kept requested: the layout may still be settling)
     pixel = (min(int(shown[0] * size[0] / display_size[0]), size[0] - 1),
              min(int(shown[1] * size[1] / display_size[1]), size[1] - 1))
-    state.probe_requested = False
+    state.probe.requested = False
     result = probe(state.scene, size, pixel)
-    if result is not None and not state.show_radiosity:
+    if result is not None and not state.offline.show_radiosity:
         key = "main"
         if samples > 1:  # a resolved edge pixel averages both sides: read 1 sample
             key = "probe"
             viewport.draw_scene(key, state.scene, size, state.scene.render.shading,
                                 state.scene.render.specular)
         result.gpu = viewport.read_pixel(key, pixel)
-    state.probe = result
-    state.probe_version += 1
+    state.probe.result = result
+    state.probe.version += 1
     if result is None:
         state.status = f"pixel {pixel}: background (no surface)"
 
@@ -46,7 +46,7 @@ def write_viewport_screenshot(state: AppState, viewport, path: str) -> None:
     from shadelab.lab.legend import burn_legend
 
     image = viewport.read_display("main")
-    if state.legend_in_screenshot:
+    if state.view.legend_in_screenshot:
         image = burn_legend(image, state)
     try:
         Image.fromarray(image).save(path)
