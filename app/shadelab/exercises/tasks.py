@@ -194,6 +194,7 @@ class Task:
 
     def check(self) -> None:
         """Every scene this task uses loads (the preset and its overrides)."""
+        self.scene()
         for shot in self.shots().values():
             self.wrap(shot.scene)
 
@@ -545,6 +546,7 @@ class ChoiceTask(Task):
         return value.strip().upper()
 
     def judge(self, answer: str, expected: Expected):
+        answer = self.parse_answer(answer, self.where)
         label = expected.detail["labels"][answer]
         return answer == expected.value, f"{answer} is '{label}'; the answer is " \
                                          f"{expected.value} ('{self.correct}')", {}
