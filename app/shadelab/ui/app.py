@@ -36,6 +36,7 @@ from shadelab.ui import (
     presenter,
     radiosity_view,
 )
+from shadelab.ui.exercise_panel import draw_exercise_panel
 from shadelab.ui.followups import FollowUps, ViewerOptions, write_window_screenshot
 from shadelab.ui.frame import guarded
 from shadelab.ui.offline import draw_offline_panel
@@ -466,6 +467,7 @@ def _docking(viewer: Viewer) -> hello_imgui.DockingParams:
         window("Offline render", "RightBottom", p(draw_offline_panel)),
         window("Algorithms", "LeftSpace", p(draw_algorithms_panel)),
         window("Hemicube & F", "RightSpace", p(radiosity_view.draw_panel)),
+        window("Exercise", "RightSpace", p(draw_exercise_panel)),
     ]
     for w in params.dockable_windows:
         # llvmpipe is fill-bound: the window clear (same color) replaces every panel's
