@@ -11,7 +11,7 @@ import pytest
 import shadelab
 from shadelab.errors import ShadeLabError
 from shadelab.exercises import load_exercise, regions
-from shadelab.exercises.tasks import api_render
+from shadelab.exercises.headless import api_render
 
 SQUARES = ("patches = [[[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], "
            "[[0, 1, 1], [1, 1, 1], [1, 0, 1], [0, 0, 1]]]\n")

@@ -45,12 +45,11 @@ def _write_json(path: str, record: dict) -> None:
 
 def run_exercise(args: argparse.Namespace) -> int:
     from shadelab.exercises import grade_exercise, load_answers, load_exercise
+    from shadelab.exercises.headless import api_render
 
     exercise = load_exercise(args.exercise)
     _check_output(args, exercise.path)
     if args.answers is None:
-        from shadelab.exercises.tasks import api_render
-
         for i, task in enumerate(exercise.tasks, 1):
             task.render = api_render
             expected = task.expected()
@@ -58,9 +57,11 @@ def run_exercise(args: argparse.Namespace) -> int:
             print(f"{i:>2}. {task.id}  {task.KIND}: {task.answer_text(expected.value)}{tol}")
         return 0
     answers = load_answers(args.answers, exercise)
-    report = grade_exercise(exercise, answers)
+    report = grade_exercise(exercise, answers, api_render)
     for line in report.lines():
         print(line)
     if args.json:
-        _write_json(args.json, report.to_json())
+        from shadelab import __version__
+
+        _write_json(args.json, report.to_json(__version__))
     return 0

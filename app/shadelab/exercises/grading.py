@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from shadelab.exercises.loader import Exercise
-from shadelab.exercises.tasks import Renderer, Result, api_render
+from shadelab.exercises.tasks import Renderer, Result
 
 
 @dataclass
@@ -33,18 +33,19 @@ class Report:
         out.append(f"total: {self.passed}/{n} passed ({100.0 * self.passed / n:.0f} %)")
         return out
 
-    def to_json(self) -> dict[str, Any]:
-        from shadelab import __version__
-
+    def to_json(self, version: str) -> dict[str, Any]:
+        """The record; ``version`` is the lab's (``shadelab.__version__``, passed in by the
+        caller: importing the package from here would close an import cycle)."""
         return {"exercise": Path(self.exercise.path).name, "name": self.exercise.name,
-                "sha256": self.exercise.sha256, "shadelab_version": __version__,
+                "sha256": self.exercise.sha256, "shadelab_version": version,
                 "tasks": [r.to_json() for r in self.results],
                 "total": {"passed": self.passed, "count": len(self.results)}}
 
 
 def grade_exercise(exercise: Exercise, answers: dict[str, Any],
-                   render: Renderer | None = api_render) -> Report:
-    """Grade parsed ``answers`` (task id -> answer; a missing id is unanswered)."""
+                   render: Renderer | None) -> Report:
+    """Grade parsed ``answers`` (task id -> answer; a missing id is unanswered); ``render``
+    draws the images (:func:`shadelab.exercises.headless.api_render` headless)."""
     results = []
     for task in exercise.tasks:
         task.render = render

@@ -1,11 +1,12 @@
 """The four task kinds: predict a number, which picture, match the target, find the pixel.
 
-Each task computes what it grades against from the lab itself (``shadelab.api.probe`` and
-``render``, the attenuation function, the radiosity form factors and solver, the Whitted ray
-tree) when :meth:`Task.expected` is first asked, and caches it. Images come from a renderer,
-a callable ``render(shot) -> (H, W, 3) float32 linear``: headless it is :func:`api_render`
-(``shadelab.render``); the viewer passes the images its GL side drew into :attr:`Task.images`
-and catches :class:`NeedImages` meanwhile. No GL or GUI module is imported here.
+Each task computes what it grades against from the lab itself (the probe of
+:mod:`shadelab.lab.probe`, raster renders, the attenuation function, the radiosity form
+factors and solver, the Whitted ray tree) when :meth:`Task.expected` is first asked, and
+caches it. Images come from a renderer, a callable ``render(shot) -> (H, W, 3) float32
+linear``: headless it is :func:`shadelab.exercises.headless.api_render` (``shadelab.render``);
+the viewer passes the images its GL side drew into :attr:`Task.images` and catches
+:class:`NeedImages` meanwhile. No GL or GUI module is imported here.
 """
 
 from __future__ import annotations
@@ -63,13 +64,6 @@ def load_scene_items(preset: str, items: list[str]):
 
 
 Renderer = Callable[[Shot], np.ndarray]
-
-
-def api_render(shot: Shot) -> np.ndarray:
-    """The raster image of a shot through the public API (headless EGL)."""
-    from shadelab.api import render
-
-    return render(shot.scene(), shot.size, shot.shading, specular=shot.specular).array
 
 
 class NeedImages(Exception):
@@ -316,8 +310,6 @@ class NumberTask(Task):
             self.patch = get_int(raw, "patch", where, default=1, hi=n - 1)
 
     def probe_data(self) -> dict:
-        from shadelab.api import probe
-
         specular = {"R.V": "phong", "N.H": "blinn"}.get(self.quantity, self.common.specular)
         scene = self.scene()
         data = self.wrap(probe, scene, self.pixel, self.size, self.common.shading, specular)
@@ -400,6 +392,33 @@ class NumberTask(Task):
             lines.append("rays by kind: " + ", ".join(f"{k} {v}" for k, v in
                                                        d["counts"].items() if k != "all"))
         return lines
+
+
+def probe(scene, pixel: tuple[int, int], size: tuple[int, int], shading: str | None,
+          specular: str | None) -> dict | None:
+    """The lab's probe (``shadelab.lab.probe``, pure numpy) as the plain data
+    ``shadelab.probe`` returns (the fields the exercises use)."""
+    from shadelab.lab.probe import probe as run_probe
+
+    result = run_probe(scene, size, pixel, shading, specular)
+    if result is None:
+        return None
+
+    def vec(v) -> list[float]:
+        return [float(c) for c in np.asarray(v, np.float64).reshape(-1)]
+
+    lights = []
+    for i, term in enumerate(result.terms.lights):
+        shadow = np.asarray(term.shadow, np.float64).reshape(-1)
+        lights.append({"to_light": vec(term.to_light), "reflected": vec(result.reflected(i)),
+                       "distance": float(term.distance), "f_att": float(term.f_att),
+                       "clamped": bool(term.clamp_active), "spot": float(term.spot),
+                       "shadow": float(shadow[0]) if np.ptp(shadow) == 0.0 else vec(shadow),
+                       "diffuse": vec(term.diffuse), "specular": vec(term.specular)})
+    return {"pixel": tuple(pixel), "shading": result.shading, "specular": result.specular,
+            "material": result.hit.mesh.material, "normal": vec(result.normal),
+            "to_eye": vec(result.to_eye), "ambient": vec(result.terms.ambient),
+            "lights": lights, "reference": vec(result.reference)}
 
 
 def probe_value(data: dict, quantity: str, light: int, channel: int) -> float:
