@@ -44,6 +44,7 @@ class ExercisePanel:
     error: str = ""
     pending: set[str] = field(default_factory=set)   # gpu request keys waiting
     choice: int = 0
+    uploaded: set[str] = field(default_factory=set)  # textures already sent (not per frame)
 
     def task_state(self, task) -> TaskState:
         return self.tasks.setdefault(task.id, TaskState())
@@ -102,9 +103,13 @@ def _try(state, panel: ExercisePanel, task, call):
 
 
 def _show(state, name: str, image: np.ndarray, width: float):
-    """Show a linear image ``width`` pixels wide; returns the clicked (x, y) of the image."""
+    """Show a linear image ``width`` pixels wide (uploaded once); returns the clicked (x, y)
+    of the image."""
     key = f"{KEY}img:{name}"
-    state.gpu.upload(key, to_srgb8(np.asarray(image)))
+    uploaded = panel_of(state).uploaded
+    if key not in uploaded:
+        state.gpu.upload(key, to_srgb8(np.asarray(image)))
+        uploaded.add(key)
     texture = state.gpu.texture(key)
     h, w = image.shape[:2]
     scale = width / w
@@ -188,6 +193,8 @@ def draw_exercise_panel(state) -> bool:
             revealed = _try(state, panel, task, lambda: task.reveal(result))
             if revealed is not None:
                 ts.reveal, ts.reveal_images = revealed.lines, revealed.images
+                panel.uploaded = {k for k in panel.uploaded
+                                  if not k.startswith(f"{KEY}img:reveal:{task.id}:")}
     imgui.same_line()
     imgui.text(f"attempts: {ts.attempts}")
     if ts.result is not None:
