@@ -9,7 +9,7 @@ import pytest
 
 PURE = ["shadelab.scene", "shadelab.scene.preset", "shadelab.scene.camera", "shadelab.shading",
         "shadelab.shading.reference", "shadelab.geometry.mesh", "shadelab.geometry.normals",
-        "shadelab.progress"]
+        "shadelab.progress", "shadelab.exercises"]
 OPTIONAL_PURE = ["shadelab.raytrace", "shadelab.radiosity", "shadelab.geometry.silhouette"]
 FORBIDDEN = ("moderngl", "glfw", "imgui_bundle", "OpenGL")
 

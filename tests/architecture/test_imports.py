@@ -9,7 +9,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2] / "app"
 PACKAGE = "shadelab"
-PURE = ("scene", "shading", "geometry", "raytrace", "radiosity")
+PURE = ("scene", "shading", "geometry", "raytrace", "radiosity", "exercises")
 GL_GUI = ("moderngl", "glfw", "imgui_bundle", "OpenGL")
 UPPER = ("gl", "raster", "ui", "studies", "bench", "cli")
 

@@ -28,6 +28,7 @@ COMMAND_MODULES = (
     "shadelab.cli.view",
     "shadelab.cli.warm",
     "shadelab.cli.sweep",
+    "shadelab.cli.exercise",
 )
 
 EXIT_BAD_INPUT = 2

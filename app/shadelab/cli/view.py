@@ -30,6 +30,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    "(PageDown / PageUp), e.g. phong-to-radiosity")
     p.add_argument("--step", type=int, default=1, metavar="N",
                    help="with --lesson: start at step N (1 = the first)")
+    p.add_argument("--exercise", metavar="FILE", help="open this exercise (presets/exercises/ "
+                   "name or .toml path) in the Exercise window")
     p.add_argument("--frames", type=int, default=0, metavar="N", help="quit after N frames")
     p.add_argument("--screenshot", metavar="PATH", help="write a PNG of the window at exit")
     p.add_argument("--compare", action="store_true", help="start in 2x2 compare mode")
@@ -199,6 +201,11 @@ def run_view(args: argparse.Namespace) -> int:
         scene, source, restored = _restored_meshes_or_preset(args, scene, source, notes)
     else:
         scene_meshes(scene)  # a broken mesh file fails here, with its one-line reason
+    exercise = None
+    if args.exercise:
+        from shadelab.exercises import load_exercise
+
+        exercise = load_exercise(args.exercise)  # checked before the window: one-line error
     check_display()  # after the input: a bad flag or preset is named even without a display
     from shadelab.lab.state import AppState
     from shadelab.ui.app import ViewerOptions, run_viewer
@@ -220,6 +227,10 @@ def run_view(args: argparse.Namespace) -> int:
         state.lesson = run
         go_to(state, args.step - 1)
     state.msaa = args.msaa
+    if exercise is not None:
+        from shadelab.ui.exercise_panel import open_exercise
+
+        open_exercise(state, exercise)
     options = ViewerOptions(frames=args.frames, screenshot=args.screenshot or "",
                             window_size=window, probe=probe, job=args.job or "",
                             bench_json=args.bench_json or "", autosave=not args.no_autosave,

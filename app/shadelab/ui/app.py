@@ -40,6 +40,7 @@ from shadelab.ui import (
     radiosity_view,
     scene_panel,
 )
+from shadelab.ui.exercise_panel import draw_exercise_panel
 from shadelab.ui.followups import FollowUps, ViewerOptions, write_window_screenshot
 from shadelab.ui.frame import guarded
 from shadelab.ui.offline import draw_offline_panel
@@ -474,6 +475,7 @@ def _docking(viewer: Viewer) -> hello_imgui.DockingParams:
         window("Offline render", "RightBottom", p(draw_offline_panel)),
         window("Algorithms", "LeftSpace", p(draw_algorithms_panel)),
         window("Hemicube & F", "RightSpace", p(radiosity_view.draw_panel)),
+        window("Exercise", "RightSpace", p(draw_exercise_panel)),
     ]
     for w in params.dockable_windows:
         # llvmpipe is fill-bound: the window clear (same color) replaces every panel's
