@@ -108,6 +108,13 @@ def main(argv: list[str] | None = None) -> int:
         # a pipe or a log (CI, a script reading the one-line error) gets no carriage returns
         progress.QUIET = bool(getattr(args, "quiet", False))
         progress.SHOW_STEPS = _interactive(sys.stderr) and not progress.QUIET
+        from shadelab.paths import NUMBA_CACHE_NOTE
+
+        if NUMBA_CACHE_NOTE:
+            progress.note(NUMBA_CACHE_NOTE)
+        from shadelab.cli.warm import autowarm
+
+        autowarm(args.command)  # a pip install's first use: kernels compile in the background
         if getattr(args, "allow_large", False):
             os.environ[ALLOW_ENV] = "1"  # seen by every check, and by worker processes
         if args.command != "view" and threading.current_thread() is threading.main_thread():
