@@ -310,7 +310,7 @@ def _listing(folder: Path) -> dict:
      ["-o", "x.png", "--npy", "ro.npy"], "read-only"),
     (lambda d: None, ["-o", "x.png", "--npy", "p.toml"], "is the input preset"),
     (lambda d: None, ["-o", "x.png", "--npy", "x.png"], "the same file as -o"),
-    (lambda d: None, ["-o", "x.exr"], "expected an image file name ending in .png"),
+    (lambda d: None, ["-o", "x.hdr"], "expected an image file name ending in .png"),
     (lambda d: None, ["-o", "noext"], "expected an image file name"),
     (lambda d: None, ["-o", "missing/x.png"], "does not exist"),
 ])
