@@ -43,9 +43,10 @@ def run(args: argparse.Namespace) -> int:
     start = time.perf_counter()
     count = warm_meshes()
     say(f"{count} preset meshes cached ({time.perf_counter() - start:.1f} s)")
-    for step in warm_kernels(None, None):
-        seconds = next(iter(step.stats.values()))
-        say(f"{step.message} ({seconds:.1f} s)")
+    for scene in _warm_scenes():
+        for step in warm_kernels(scene, None):
+            seconds = next(iter(step.stats.values()))
+            say(f"{step.message} ({seconds:.1f} s)")
     say(f"kernels ready in {time.perf_counter() - start:.1f} s "
         f"(cache: {os.environ.get('NUMBA_CACHE_DIR', 'numba default')})")
     mark = done_mark()
@@ -56,6 +57,24 @@ def run(args: argparse.Namespace) -> int:
         except OSError:  # an unwritable cache: the kernels were still compiled for this run
             pass
     return 0
+
+
+#: Presets whose scenes the kernels are compiled on besides cornell's: their scenes make numba
+#: compile further specializations of some kernels (seen: add_misses and hit_surfaces on
+#: lecture), which a user's first render would otherwise wait for.
+WARM_PRESETS = ("lecture", "whitted")
+
+
+def _warm_scenes():
+    from shadelab.errors import ShadeLabError
+    from shadelab.scene.preset import load_preset
+
+    yield None                     # cornell (warm_kernels' own choice)
+    for name in WARM_PRESETS:
+        try:
+            yield load_preset(name)
+        except ShadeLabError:      # a renamed preset must not break the warm-up
+            continue
 
 
 def _stamp() -> str:
@@ -103,7 +122,7 @@ def autowarm(command: str | None) -> bool:
     from shadelab.progress import note
 
     note(f"first run: compiling the CPU renderers' kernels once, in the background "
-         f"(about 20 s; cached in '{mark.parent}')")
+         f"(20-60 s; cached in '{mark.parent}')")
     return True
 
 
