@@ -103,7 +103,8 @@ class Image:
         path = Path(path)
         suffix = path.suffix.lower()
         if suffix not in (".png", ".exr", ".npy"):
-            raise ShadeLabError(f"save '{path}': expected a .png, .exr or .npy file name")
+            raise ShadeLabError(f"save '{path}': expected a .png or .npy file name, or .exr "
+                                "for linear float RGB")
         check_writable(str(path), "save")
         if suffix == ".npy":
             write_npy(str(path), self.array)

@@ -53,7 +53,7 @@ GAMA_SRGB = (45455).to_bytes(4, "big")     # 1/2.2 x 100000, the sRGB chunk's gA
 def image_metadata(**fields) -> dict[str, str]:
     """The text an image carries: ``fields`` that are set (lists as JSON), the ShadeLab
     version and ``Software``."""
-    from shadelab import __version__
+    from shadelab.version import __version__
 
     meta = {}
     for key, value in fields.items():

@@ -86,5 +86,5 @@ def test_exr_bad_outputs_are_one_line(tmp_path, capsys):
     with pytest.raises(shadelab.ShadeLabError, match="read-only") as info:
         shadelab.Image(np.zeros((2, 2, 3))).save(kept)
     assert "\n" not in str(info.value) and kept.read_bytes() == b"keep"
-    with pytest.raises(shadelab.ShadeLabError, match=r"\.png, \.exr or \.npy"):
+    with pytest.raises(shadelab.ShadeLabError, match=r"\.png or \.npy file name, or \.exr"):
         shadelab.Image(np.zeros((2, 2, 3))).save(tmp_path / "x.hdr")

@@ -80,7 +80,7 @@ def _warm_scenes():
 def _stamp() -> str:
     from importlib.metadata import PackageNotFoundError, version
 
-    from shadelab import __version__
+    from shadelab.version import __version__
 
     try:
         numba = version("numba")
