@@ -20,6 +20,12 @@ settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 # The mesh cache (shadelab.geometry.cache) of this test run: shared by its tests and the
 # viewers they start, never the user's own ~/.cache
 os.environ["SHADELAB_CACHE_DIR"] = tempfile.mkdtemp(prefix="shadelab-test-cache-")
+# numba's kernel cache of the tests: not the user's (shadelab sets NUMBA_CACHE_DIR at import),
+# kept between runs so the suite compiles its kernels once; no background warm-up is started
+os.environ["NUMBA_CACHE_DIR"] = os.path.join(
+    tempfile.gettempdir(), f"shadelab-test-numba-{os.getuid() if hasattr(os, 'getuid') else 0}")
+os.environ["SHADELAB_AUTOWARM"] = "0"
+assert "numba" not in sys.modules, "numba was imported before its test cache folder was set"
 
 ROOT = Path(__file__).resolve().parent.parent
 # Tests live in one folder per layer (tests/scene, tests/raster, ...); their shared helpers

@@ -8,7 +8,12 @@ The Python API (:mod:`shadelab.api`) is re-exported here and imported on first u
     shadelab.render(scene, size=(256, 256), shading="phong").save("cornell.png")
 """
 
-__version__ = "0.1.0"
+from shadelab.paths import configure_numba_cache as _configure_numba_cache
+from shadelab.version import __version__  # one place: version.py
+
+# numba's kernel cache goes to the user's cache folder, set before any kernel module imports
+# numba (the one place; see shadelab.paths)
+_configure_numba_cache()
 
 _API = ("PIPELINES", "Image", "ShadeLabError", "load_preset", "save_preset", "list_presets",
         "render", "probe", "show")

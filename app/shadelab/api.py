@@ -97,25 +97,39 @@ class Image:
         return to_srgb8(self.array, self.exposure)
 
     def save(self, path: str | Path) -> Path:
-        """Write ``.png`` (sRGB 8-bit) or ``.npy`` (float32 linear radiance).
+        """Write ``.png`` (sRGB 8-bit, with text chunks saying what made it and an sRGB chunk),
+        ``.exr`` (linear float32 RGB, the array itself) or ``.npy`` (float32 linear radiance).
 
         Returns
         -------
         pathlib.Path
             The file written.
         """
-        from shadelab.imageio import check_writable, write_npy, write_png
+        from shadelab.imageio import check_image_name, check_writable, write_npy, write_png
 
         path = Path(path)
         suffix = path.suffix.lower()
-        if suffix not in (".png", ".npy"):
-            raise ShadeLabError(f"save '{path}': expected a .png or .npy file name")
+        if suffix not in (".png", ".exr", ".npy"):
+            raise ShadeLabError(f"save '{path}': expected a .png or .npy file name, or .exr "
+                                "for linear float RGB")
         check_writable(str(path), "save")
         if suffix == ".npy":
             write_npy(str(path), self.array)
         else:
-            write_png(str(path), self.array, self.exposure)
+            check_image_name(str(path), "save")
+            write_png(str(path), self.array, self.exposure, self.metadata())
         return path
+
+    def metadata(self) -> dict[str, str]:
+        """The text a saved PNG (or EXR header) carries: preset, overrides, pipeline and
+        shading where :attr:`info` has them, the ShadeLab version and ``Software``."""
+        from shadelab.imageio import image_metadata
+
+        fields = {key: self.info.get(key) for key in ("preset", "overrides", "pipeline",
+                                                       "shading")}
+        if isinstance(fields["overrides"], Mapping):
+            fields["overrides"] = _override_items(fields["overrides"])
+        return image_metadata(**{k: v for k, v in fields.items() if v is not None})
 
     def _repr_png_(self) -> bytes:
         """Jupyter's inline display: the sRGB PNG bytes."""

@@ -1,8 +1,15 @@
-"""Image output and the CLI arguments every renderer shares (PRESET, -o, --size, --set, --npy)."""
+"""Image output and the CLI arguments every renderer shares (PRESET, -o, --size, --set, --npy).
+
+PNGs say what they are: text chunks (``preset``, ``overrides`` as a JSON list of ``--set``
+items, ``pipeline``, ``shading``, ``ShadeLab version``, ``Software``) and an sRGB chunk
+(with its gAMA fallback). ``.exr`` files hold the linear float32 RGB radiance ``--npy``
+writes (OpenEXR's Python bindings; the same text as string attributes of the header).
+"""
 
 from __future__ import annotations
 
 import argparse
+import json
 from pathlib import Path
 
 import numpy as np
@@ -33,7 +40,42 @@ def parse_size(text: str) -> tuple[int, int]:
 
 
 IMAGE_FORMATS = {".png": "PNG", ".jpg": "JPEG", ".jpeg": "JPEG", ".tif": "TIFF",
-                 ".tiff": "TIFF", ".bmp": "BMP"}
+                 ".tiff": "TIFF", ".bmp": "BMP", ".exr": "EXR"}
+
+#: The pipeline each CLI command runs, as the PNG's ``pipeline`` text says it.
+COMMAND_PIPELINES = {"render": "raster", "raytrace": "raytrace", "pathtrace": "pathtrace",
+                     "radiosity": "radiosity"}
+
+SRGB_INTENT = b"\x00"                       # perceptual
+GAMA_SRGB = (45455).to_bytes(4, "big")     # 1/2.2 x 100000, the sRGB chunk's gAMA fallback
+
+
+def image_metadata(**fields) -> dict[str, str]:
+    """The text an image carries: ``fields`` that are set (lists as JSON), the ShadeLab
+    version and ``Software``."""
+    from shadelab.version import __version__
+
+    meta = {}
+    for key, value in fields.items():
+        if value is None or value == "" or (isinstance(value, (list, tuple)) and not value
+                                            and key != "overrides"):
+            continue
+        meta[key] = value if isinstance(value, str) else json.dumps(
+            list(value) if isinstance(value, tuple) else value)
+    meta["ShadeLab version"] = __version__
+    meta["Software"] = f"ShadeLab {__version__}"
+    return meta
+
+
+def cli_metadata(args: argparse.Namespace, **extra) -> dict[str, str]:
+    """What a CLI render's image says about itself: preset, --set items, pipeline (+ extra)."""
+    command = getattr(args, "command", None)
+    pipeline = COMMAND_PIPELINES.get(command, command)
+    if pipeline == "raster" and getattr(args, "visibility", None) == "painter":
+        pipeline = "painter"
+    return image_metadata(preset=getattr(args, "preset", None),
+                          overrides=list(getattr(args, "set", None) or []),
+                          pipeline=pipeline, **extra)
 
 
 def check_writable(path: str | None, flag: str) -> None:
@@ -50,12 +92,54 @@ def check_image_name(path: str | None, flag: str) -> None:
     if path and Path(path).suffix.lower() not in IMAGE_FORMATS:
         raise ShadeLabError(f"{flag} '{path}': expected an image file name ending in "
                             f"{', '.join(IMAGE_FORMATS)} (--npy writes float data)")
+    if path and Path(path).suffix.lower() == ".exr":
+        _openexr(flag, path)
 
 
-def _png_writer(path: str, linear: np.ndarray, exposure: float):
+def _openexr(flag: str, path: str):
+    try:
+        import OpenEXR
+    except ImportError:
+        raise ShadeLabError(f"{flag} '{path}': writing .exr needs OpenEXR's Python bindings "
+                            "(pip install OpenEXR)") from None
+    return OpenEXR
+
+
+def _png_writer(path: str, linear: np.ndarray, exposure: float,
+                meta: dict[str, str] | None = None):
+    if Path(path).suffix.lower() == ".exr":
+        return _exr_writer(path, linear, meta)
     image = Image.fromarray(to_srgb8(linear, exposure))
     fmt = IMAGE_FORMATS.get(Path(path).suffix.lower(), "PNG")
-    return lambda handle: image.save(handle, format=fmt)
+    if fmt != "PNG":
+        return lambda handle: image.save(handle, format=fmt)
+    from PIL.PngImagePlugin import PngInfo
+
+    info = PngInfo()
+    info.add(b"sRGB", SRGB_INTENT)
+    info.add(b"gAMA", GAMA_SRGB)
+    for key, value in (meta or image_metadata()).items():
+        info.add_text(key, value)  # iTXt where the text is not Latin-1
+    return lambda handle: image.save(handle, format="PNG", pnginfo=info)
+
+
+def _exr_writer(path: str, linear: np.ndarray, meta: dict[str, str] | None = None):
+    """Linear float32 RGB (H, W, 3), row 0 at the top, ZIP-compressed, no exposure applied."""
+    exr = _openexr("-o", path)
+    pixels = np.ascontiguousarray(linear, dtype=np.float32)
+    header = {"compression": exr.ZIP_COMPRESSION, "type": exr.scanlineimage}
+    header.update(meta or image_metadata())
+
+    def write(handle) -> None:
+        try:
+            with exr.File(header, {"RGB": pixels}) as image:
+                image.write(handle)
+        except OSError:
+            raise
+        except Exception as exc:  # the bindings raise RuntimeError / ValueError
+            raise OSError(0, f"OpenEXR: {exc}") from None
+
+    return write
 
 
 def _npy_writer(linear: np.ndarray):
@@ -63,11 +147,13 @@ def _npy_writer(linear: np.ndarray):
     return lambda handle: np.save(handle, array)  # a handle: exactly the name given
 
 
-def write_png(path: str, linear: np.ndarray, exposure: float = 1.0) -> None:
-    """Write linear RGB (H, W, 3) as an sRGB image (PNG unless the extension says otherwise),
-    through a temporary file renamed when complete."""
+def write_png(path: str, linear: np.ndarray, exposure: float = 1.0,
+              meta: dict[str, str] | None = None) -> None:
+    """Write linear RGB (H, W, 3) as an sRGB image (PNG unless the extension says otherwise;
+    ``.exr``: linear float32), through a temporary file renamed when complete. ``meta``: the
+    PNG's text chunks (default: the version and ``Software`` only)."""
     with OutputSet() as out:
-        out.write("-o", path, _png_writer(path, linear, exposure))
+        out.write("-o", path, _png_writer(path, linear, exposure, meta))
 
 
 def write_npy(path: str, linear: np.ndarray) -> None:
@@ -78,7 +164,9 @@ def write_npy(path: str, linear: np.ndarray) -> None:
 
 def add_scene_arguments(parser: argparse.ArgumentParser, default_size: str = "800x600") -> None:
     parser.add_argument("preset", metavar="PRESET", help="preset name from presets/ or a path")
-    parser.add_argument("-o", "--output", required=True, metavar="OUT.png", help="PNG to write")
+    parser.add_argument("-o", "--output", required=True, metavar="OUT.png",
+                        help="image to write: .png (sRGB, with its parameters as text) or "
+                             ".exr (linear float RGB)")
     parser.add_argument("--size", default=default_size, metavar="WxH", help="image size")
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                         help="override a preset value, e.g. materials.white.kd=0.5")
@@ -93,10 +181,13 @@ def add_allow_large(parser: argparse.ArgumentParser) -> None:
                              "patches); memory beyond this machine's is refused even then")
 
 
-def save_outputs(args: argparse.Namespace, image: np.ndarray, exposure: float = 1.0) -> None:
-    """Write -o and --npy together: both are renamed into place only once both are written."""
+def save_outputs(args: argparse.Namespace, image: np.ndarray, exposure: float = 1.0,
+                 meta: dict | None = None) -> None:
+    """Write -o and --npy together: both are renamed into place only once both are written.
+    The image's text: :func:`cli_metadata` of ``args`` and ``meta`` (e.g. the shading)."""
+    text = cli_metadata(args, **(meta or {}))
     with OutputSet() as out:
-        out.write("-o", args.output, _png_writer(args.output, image, exposure))
+        out.write("-o", args.output, _png_writer(args.output, image, exposure, text))
         if args.npy:
             out.write("--npy", args.npy, _npy_writer(image))
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 import errno
 import os
 import stat
+import sys
 import tempfile
 from pathlib import Path
 from typing import Callable
@@ -174,3 +175,73 @@ class OutputSet:
                 self.discard()
         else:
             self.discard()
+
+
+# ---------------------------------------------------------------- the numba cache folder
+
+NUMBA_ENV = "NUMBA_CACHE_DIR"
+#: One line for the CLI to print when the cache folder could not be used (else None).
+NUMBA_CACHE_NOTE: str | None = None
+
+
+def user_cache_root() -> Path:
+    """ShadeLab's cache folder: ``$SHADELAB_CACHE_DIR``, else ``$XDG_CACHE_HOME/shadelab``,
+    else ``~/.cache/shadelab`` (the mesh cache's folder, :mod:`shadelab.geometry.cache`)."""
+    chosen = os.environ.get("SHADELAB_CACHE_DIR", "").strip()
+    if chosen and chosen.lower() != "off":
+        return Path(chosen)
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "shadelab"
+
+
+def folder_problem(folder: Path) -> str | None:
+    """None if ``folder`` is, or can be made, a writable folder (nothing is created)."""
+    probe = folder
+    while True:
+        try:
+            info = os.stat(probe)
+        except FileNotFoundError:
+            if probe.parent == probe:
+                return "has no existing parent folder"
+            probe = probe.parent
+            continue
+        except OSError as exc:
+            return _reason(exc)
+        if not stat.S_ISDIR(info.st_mode):
+            return f"cannot be made: '{probe}' is not a folder"
+        if not os.access(probe, os.W_OK | os.X_OK):
+            return f"is not writable ('{probe}': permission denied)"
+        return None
+
+
+def configure_numba_cache() -> str | None:
+    """Point numba's on-disk kernel cache at ``<user cache>/numba`` (never site-packages,
+    which numba's default would use and which many installs cannot write), unless the user
+    set ``NUMBA_CACHE_DIR`` already. Must run before numba is first imported: ``import
+    shadelab`` calls it (the one place). A folder that cannot be written falls back to one
+    under the system's temporary folder; the reason is kept in :data:`NUMBA_CACHE_NOTE`
+    (one line, printed by the CLI) and returned. Nothing is created here."""
+    global NUMBA_CACHE_NOTE
+    folder = os.environ.get(NUMBA_ENV, "")
+    if not folder:
+        try:
+            wanted = user_cache_root() / "numba"
+            problem = folder_problem(wanted)
+        except (RuntimeError, KeyError, OSError):  # no home folder (Path.home() fails)
+            wanted, problem = Path("~/.cache/shadelab/numba"), "has no home folder to live in"
+        folder = str(wanted)
+        if problem:
+            uid = os.getuid() if hasattr(os, "getuid") else 0
+            fallback = Path(tempfile.gettempdir()) / f"shadelab-numba-{uid}"
+            if folder_problem(fallback) is None:
+                folder = str(fallback)
+                NUMBA_CACHE_NOTE = (f"numba cache folder '{wanted}' {problem}; kernels are "
+                                    f"cached in '{fallback}' instead")
+            else:
+                NUMBA_CACHE_NOTE = (f"numba cache folder '{wanted}' {problem}; kernels will "
+                                    "compile again in every process")
+        os.environ[NUMBA_ENV] = folder
+    config = sys.modules.get("numba.core.config")
+    if config is not None and not getattr(config, "CACHE_DIR", ""):
+        config.CACHE_DIR = folder  # numba imported first (a notebook): its locator reads this
+    return NUMBA_CACHE_NOTE

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -309,7 +310,7 @@ def _listing(folder: Path) -> dict:
      ["-o", "x.png", "--npy", "ro.npy"], "read-only"),
     (lambda d: None, ["-o", "x.png", "--npy", "p.toml"], "is the input preset"),
     (lambda d: None, ["-o", "x.png", "--npy", "x.png"], "the same file as -o"),
-    (lambda d: None, ["-o", "x.exr"], "expected an image file name ending in .png"),
+    (lambda d: None, ["-o", "x.hdr"], "expected an image file name ending in .png"),
     (lambda d: None, ["-o", "noext"], "expected an image file name"),
     (lambda d: None, ["-o", "missing/x.png"], "does not exist"),
 ])
@@ -569,26 +570,45 @@ sys.exit(main(sys.argv[1:]))
 
 @pytest.mark.parametrize("how", ["SIGTERM", "SIGKILL"])
 def test_raytrace_workers_never_outlive_the_main_process(tmp_path, how):
+    import fcntl
+    import pty
     import signal
+    import struct
+    import termios
     import time
 
     preset = _preset(tmp_path, GOOD)
+    # stderr a terminal (a pty 120 columns wide): the bar is drawn only there, never in a pipe
+    master, slave = pty.openpty()
+    fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 40, 120, 0, 0))
     proc = subprocess.Popen([sys.executable, "-m", "shadelab", "raytrace", preset, "-o",
                              str(tmp_path / "x.png"), "--size", "1024x1024", "--spp", "64",
                              "--workers", "2", "--allow-large"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=slave, text=True)
+    os.close(slave)
     import threading
 
     seen: list[str] = []
-    reader = threading.Thread(target=lambda: seen.extend(iter(lambda: proc.stderr.read(1), "")),
-                              daemon=True)
+
+    def read() -> None:
+        while True:
+            try:
+                data = os.read(master, 1024)
+            except OSError:
+                return
+            if not data:
+                return
+            seen.append(data.decode(errors="replace"))
+
+    reader = threading.Thread(target=read, daemon=True)
     reader.start()
     deadline = time.monotonic() + 120
     # Tiles are coming back: both workers are past their start-up (a worker still importing
     # when its parent dies ends when its initializer runs, which may take a few seconds).
     import re
 
-    while time.monotonic() < deadline and not re.search(r"\| *[1-9]\d*/", "".join(seen)):
+    while time.monotonic() < deadline and not re.search(r"\| *[1-9][\d.]*[kMG]?/",
+                                                         "".join(seen)):
         time.sleep(0.2)
     kids = _children(proc.pid)
     assert len(kids) >= 2, (kids, "".join(seen)[-300:])
@@ -598,6 +618,7 @@ def test_raytrace_workers_never_outlive_the_main_process(tmp_path, how):
     assert left == [], f"left running after {how}: " + "; ".join(
         open(f"/proc/{k}/cmdline").read().replace("\0", " ")[:120] for k in left if _alive(k))
     assert not (tmp_path / "x.png").exists()
+    os.close(master)
 
 
 @pytest.mark.parametrize("args, expected", [

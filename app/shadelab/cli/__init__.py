@@ -48,10 +48,18 @@ def build_parser() -> argparse.ArgumentParser:
     from shadelab import __version__
 
     parser.add_argument("--version", action="version", version=f"shadelab {__version__}")
+    parser.add_argument(*QUIET_FLAGS, action="store_true", help=QUIET_HELP)
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     for name in COMMAND_MODULES:
         importlib.import_module(name).add_parser(sub)
+    for command in sub.choices.values():  # global: before or after the subcommand
+        command.add_argument(*QUIET_FLAGS, action="store_true", default=argparse.SUPPRESS,
+                             help=QUIET_HELP)
     return parser
+
+
+QUIET_FLAGS = ("-q", "--quiet")
+QUIET_HELP = "no progress bars and no notes on stderr (errors still print)"
 
 
 class _Terminated(BaseException):
@@ -86,17 +94,28 @@ def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     parser = build_parser()
     commands = set(parser._subparsers._group_actions[0].choices)  # noqa: SLF001
-    if not argv or (argv[0] not in commands and argv[0] not in ("-h", "--help", "--version")):
-        argv = ["view", *argv]  # 'shadelab [PRESET] [view options]' opens the viewer
+    lead = argv[:1] if argv[:1] and argv[0] in QUIET_FLAGS else []  # 'shadelab -q render'
+    rest = argv[len(lead):]
+    if not rest or (rest[0] not in commands and rest[0] not in ("-h", "--help", "--version")):
+        argv = [*lead, "view", *rest]  # 'shadelab [PRESET] [view options]' opens the viewer
     saved_allow = os.environ.get(ALLOW_ENV)
     saved_term = None
+    from shadelab import progress
+
+    saved_quiet = progress.QUIET
     try:
         args = parser.parse_args(argv)
-        from shadelab import progress
-
         # steps over ~2 s (validation, meshes) show a bar on stderr, when a person watches it:
         # a pipe or a log (CI, a script reading the one-line error) gets no carriage returns
-        progress.SHOW_STEPS = _interactive(sys.stderr)
+        progress.QUIET = bool(getattr(args, "quiet", False))
+        progress.SHOW_STEPS = _interactive(sys.stderr) and not progress.QUIET
+        from shadelab.paths import NUMBA_CACHE_NOTE
+
+        if NUMBA_CACHE_NOTE:
+            progress.note(NUMBA_CACHE_NOTE)
+        from shadelab.cli.warm import autowarm
+
+        autowarm(args.command)  # a pip install's first use: kernels compile in the background
         if getattr(args, "allow_large", False):
             os.environ[ALLOW_ENV] = "1"  # seen by every check, and by worker processes
         if args.command != "view" and threading.current_thread() is threading.main_thread():
@@ -132,6 +151,7 @@ def main(argv: list[str] | None = None) -> int:
             pass
         return 0
     finally:
+        progress.QUIET = saved_quiet
         if saved_term is not None:
             signal.signal(signal.SIGTERM, saved_term)
         if saved_allow is None:

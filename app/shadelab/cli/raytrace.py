@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import sys
 
 from shadelab import limits
 from shadelab.errors import ShadeLabError
@@ -66,8 +65,9 @@ def _check_scene(scene, preset: str) -> None:
 
 def _note_if_nothing_visible(stats: dict) -> None:
     if stats.get("primary_hits", 1) == 0:
-        print("note: no object is visible from the camera; the image is the background",
-              file=sys.stderr)
+        from shadelab.progress import note
+
+        note("no object is visible from the camera; the image is the background")
 
 
 def run_raytrace(args: argparse.Namespace) -> int:

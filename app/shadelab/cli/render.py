@@ -102,7 +102,8 @@ def run_render(args: argparse.Namespace) -> int:
 
         gl = context_info(headless_context())
         print(f"gl: {gl['backend']}, {gl['renderer']}, OpenGL {gl['version']}")
-    save_outputs(args, image, scene.render.exposure)
+    save_outputs(args, image, scene.render.exposure,
+                 {"shading": args.shading or scene.render.shading})
     print(f"wrote {args.output} ({size[0]}x{size[1]}, {args.shading or scene.render.shading})")
     return 0
 

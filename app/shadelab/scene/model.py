@@ -10,7 +10,7 @@ Names follow the lecture (``Ia``, ``ka``, ``kd``, ``ks``, ``n``, ``Od``, ``Os``,
 from __future__ import annotations
 
 import itertools
-from dataclasses import dataclass, field, fields
+from dataclasses import MISSING, dataclass, field, fields
 from typing import Any
 
 Rgb = tuple[float, float, float]
@@ -285,3 +285,123 @@ class Scene(Checked):
 
     def active_lights(self) -> list[Light]:
         return [light for light in self.lights if light.enabled]
+
+
+# ---------------------------------------------------------------- display (REPL, Jupyter)
+# Readable reprs: the lecture's key fields of each part, then every field that differs from
+# its default; ``_repr_html_`` draws the same as small tables in a notebook. Installed on the
+# classes below their definitions (a dataclass writes its own __repr__ into each class).
+
+_KEY_FIELDS = {"Camera": ("eye", "target", "fov_y"), "Light": ("kind", "position", "Ip"),
+               "Material": ("ka", "kd", "ks", "n", "Od"), "Object": ("shape", "material")}
+_MAX_ROWS = 50     # rows of an HTML table, lights and materials in the text
+_TEXT_ROWS = 12    # objects listed by the text repr
+
+
+def _fmt(value: Any) -> str:
+    if isinstance(value, bool):
+        return str(value)
+    if isinstance(value, float):
+        return f"{value:.4g}"
+    if isinstance(value, tuple):
+        return "(" + ", ".join(_fmt(v) for v in value) + ")"
+    if isinstance(value, list):
+        return "[" + ", ".join(_fmt(v) for v in value) + "]"
+    return repr(value)
+
+
+def _default_of(f: Any) -> Any:
+    return f.default_factory() if f.default_factory is not MISSING else f.default
+
+
+def _shown(obj: Any) -> list[tuple[str, Any]]:
+    """(name, value) of the key fields and of every field off its default, in field order."""
+    key = _KEY_FIELDS.get(type(obj).__name__, ())
+    out = []
+    for f in fields(obj):
+        if "spec" not in f.metadata:
+            continue
+        value = getattr(obj, f.name)
+        default = _default_of(f)
+        same = (list(value) == list(default) if isinstance(value, (tuple, list))
+                and isinstance(default, (tuple, list)) else value == default)
+        if f.name in key or not same:
+            out.append((f.name, value))
+    return out
+
+
+def _part_repr(self: Any) -> str:
+    return f"{type(self).__name__}(" + ", ".join(f"{k}={_fmt(v)}" for k, v in _shown(self)) + ")"
+
+
+def _esc(value: Any) -> str:
+    import html
+
+    return html.escape(value if isinstance(value, str) else _fmt(value))
+
+
+def _table(header: list[str], rows: list[list[Any]], more: int = 0) -> str:
+    head = "".join(f"<th style='text-align:left'>{_esc(h)}</th>" for h in header)
+    body = "".join("<tr>" + "".join(f"<td style='text-align:left'>{_esc(c)}</td>" for c in row)
+                   + "</tr>" for row in rows)
+    tail = (f"<tr><td colspan='{len(header)}'>… and {more} more</td></tr>" if more else "")
+    return f"<table><thead><tr>{head}</tr></thead><tbody>{body}{tail}</tbody></table>"
+
+
+def _part_html(self: Any) -> str:
+    return (f"<b>{_esc(type(self).__name__)}</b>"
+            + _table(["field", "value"], [[k, v] for k, v in _shown(self)]))
+
+
+def _scene_summary(self: Scene) -> str:
+    n_obj, n_light, n_mat = len(self.objects), len(self.lights), len(self.materials)
+    return (f"{n_obj} object{'s' * (n_obj != 1)}, {n_light} light{'s' * (n_light != 1)}, "
+            f"{n_mat} material{'s' * (n_mat != 1)}; shading {self.render.shading}, "
+            f"specular {self.render.specular}, shadows {self.render.shadows}")
+
+
+def _scene_repr(self: Scene) -> str:
+    lines = [f"Scene {self.name or '(unnamed)'!r}: {_scene_summary(self)}"]
+    if self.description:
+        lines.append(f"  {self.description}")
+    lines.append(f"  camera: {_part_repr(self.camera)}")
+    lines.append(f"  Ia: {_fmt(tuple(self.Ia))}")
+    lines += [f"  lights[{i}]: {_part_repr(light)}" for i, light in
+              enumerate(self.lights[:_MAX_ROWS])]
+    lines += [f"  materials[{name!r}]: {_part_repr(m)}" for name, m in
+              list(self.materials.items())[:_MAX_ROWS]]
+    lines += [f"  objects[{i}]: {_part_repr(o)}" for i, o in enumerate(self.objects[:_TEXT_ROWS])]
+    hidden = max(0, len(self.objects) - _TEXT_ROWS)
+    if hidden:
+        lines.append(f"  ... and {hidden} more objects")
+    return "\n".join(lines)
+
+
+def _scene_html(self: Scene) -> str:
+    parts = [f"<b>Scene {_esc(self.name or '(unnamed)')}</b>: {_esc(_scene_summary(self))}"]
+    if self.description:
+        parts.append(f"<br><i>{_esc(self.description)}</i>")
+    cam = self.camera
+    parts.append("<br>camera: eye " + _esc(tuple(cam.eye)) + ", target " + _esc(tuple(cam.target))
+                 + f", fov_y {_esc(cam.fov_y)}°; Ia {_esc(tuple(self.Ia))}")
+    lights = [[i, light.kind, light.name, light.enabled, light.position, light.direction,
+               light.Ip, light.attenuation] for i, light in enumerate(self.lights)]
+    parts.append(_table(["lights", "kind", "name", "enabled", "position", "direction", "Ip",
+                         "attenuation"], lights[:_MAX_ROWS], max(0, len(lights) - _MAX_ROWS)))
+    mats = [[name, m.ka, m.kd, m.ks, m.n, m.Od, m.Os, m.kt, m.emission]
+            for name, m in self.materials.items()]
+    parts.append(_table(["materials", "ka", "kd", "ks", "n", "Od", "Os", "kt", "emission"],
+                        mats[:_MAX_ROWS], max(0, len(mats) - _MAX_ROWS)))
+    objs = [[i, o.name, o.shape, o.material, o.translate, o.normals]
+            for i, o in enumerate(self.objects)]
+    parts.append(_table(["objects", "name", "shape", "material", "translate", "normals"],
+                        objs[:_MAX_ROWS], max(0, len(objs) - _MAX_ROWS)))
+    return "".join(parts)
+
+
+for _cls in (Camera, Light, Material, Object, RenderSettings, RaytraceSettings,
+             RadiositySettings):
+    _cls.__repr__ = _part_repr
+    _cls._repr_html_ = _part_html
+Scene.__repr__ = _scene_repr
+Scene._repr_html_ = _scene_html
