@@ -64,6 +64,15 @@ def run_scenario_main(scenarios: dict, name: str, out_dir: str, preset: str = "c
     state.screenshot_dir = out_dir
 
     def body(ctx, state):
+        # The engine's watchdog ends a test after 60 s of wall time; at 3840x2160 on llvmpipe,
+        # with the other test worker busy on 2 cores, a layout walk takes longer than that
+        # without being stuck. pytest's own timeout (run_scenario) still bounds every run.
+        from imgui_bundle import hello_imgui, imgui
+
+        io = imgui.test_engine.get_io(hello_imgui.get_imgui_test_engine())
+        io.config_watchdog_warning = WATCHDOG_S / 2
+        io.config_watchdog_kill_test = WATCHDOG_S
+        io.config_watchdog_kill_app = WATCHDOG_S + 30
         scenario(ctx, state, out)
 
     run_viewer(state, ViewerOptions(window_size=window_size, test_function=body, **options))
@@ -71,6 +80,7 @@ def run_scenario_main(scenarios: dict, name: str, out_dir: str, preset: str = "c
     return 0
 
 
+WATCHDOG_S = 400.0  # seconds a scenario may run before the test engine aborts it
 GL_MODULES = ("moderngl", "OpenGL", "glfw", "shadelab.gl", "shadelab.raster",
               "shadelab.ui.viewport", "shadelab.ui.gpu_side")
 
