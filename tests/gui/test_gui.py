@@ -94,6 +94,9 @@ def test_click_probes_the_pixel_and_lists_terms_that_add_up(xdisplay, tmp_path):
     np.testing.assert_allclose(r["sum_of_terms"], r["reference"], rtol=1e-9)
     assert r["arrows"] >= 4 and r["material"] == "white"
     assert r["camera_moved"] and r["camera_reset"]
+    assert r["touch_probed"] and r["touch_camera_kept"]
+    tx, ty = r["touch_pixel"]
+    assert abs(tx - 0.25 * w) <= 2 and abs(ty - 0.75 * h) <= 2
 
 
 def test_save_reload_broken_file_and_autosave(xdisplay, tmp_path):
@@ -249,6 +252,18 @@ def scenario_probe_click(ctx, state, out: dict) -> None:
     ctx.key_press(imgui_key("r"))
     ctx.yield_(2)
     out["camera_reset"] = tuple(state.scene.camera.eye) == tuple(eye)
+    # a touch-style press: the pointer lands a quarter of the way in with no move between,
+    # then goes down and up in place: a probe of that pixel, the camera untouched
+    rect = ctx.item_info("viewport_input").rect_full
+    w, h = rect.max.x - rect.min.x, rect.max.y - rect.min.y
+    ctx.mouse_teleport_to_pos(imgui_vec(rect.min.x + 0.25 * w, rect.min.y + 0.75 * h))
+    state.probe.result = None
+    ctx.mouse_down(0)
+    ctx.mouse_up(0)
+    ok = _wait(ctx, lambda: state.probe.result is not None and not state.probe.requested)
+    out["touch_probed"] = ok
+    out["touch_pixel"] = list(state.probe.result.pixel) if ok else None
+    out["touch_camera_kept"] = tuple(state.scene.camera.eye) == tuple(eye)
 
 
 def scenario_save_reload(ctx, state, out: dict) -> None:

@@ -91,3 +91,22 @@ def test_drag_orbits_with_the_left_button_else_pans_by_the_pane_height():
     pan(b, 30.0, 10.0, 150)
     assert (a.eye, a.target) == (b.eye, b.target)
     assert CLICK_SLOP > 0
+
+
+def test_a_press_at_a_new_position_probes_instead_of_orbiting():
+    """A touch panel or whiteboard sends a press far from the last pointer position with no
+    move in between: motion counts from the press, so it is a click (before: the jump of the
+    frame's mouse delta, hundreds of pixels, orbited the camera)."""
+    from shadelab.lab.camera_control import CLICK_SLOP, PointerDrag
+
+    pointer = PointerDrag()
+    pointer.press((640.0, 420.0))               # a press that lands where the pointer is
+    assert pointer.move((640.0, 420.0)) == (0.0, 0.0) and pointer.is_click
+    # the frame's mouse delta would have been the jump from the last position (10, 10)
+    assert pointer.move((641.0, 421.0)) == (0.0, 0.0) and pointer.is_click  # within the slop
+    # a real drag: once past CLICK_SLOP every move turns the camera, by its own motion
+    assert pointer.move((650.0, 421.0)) == (9.0, 0.0) and not pointer.is_click
+    assert pointer.move((650.0, 431.0)) == (0.0, 10.0)
+    assert pointer.travel == pytest.approx(2.0 + 9.0 + 10.0) and CLICK_SLOP < 9.0
+    # a drag keeps its big moves once it is one
+    assert pointer.move((730.0, 431.0)) == (80.0, 0.0)

@@ -71,3 +71,35 @@ def drag(camera: Camera, dx: float, dy: float, rotate: bool, orbit_height: int,
         orbit(camera, dx, dy, orbit_height)
     else:
         pan(camera, dx, dy, pan_height, pan_width)
+
+
+class PointerDrag:
+    """One press of a pointer over the viewport: a click (probe) or a drag (orbit / pan).
+
+    A touch panel or an interactive whiteboard sends a press with no move before it: the
+    pointer's new position and the press reach ImGui in one frame, whose mouse delta is the
+    jump from the last position, and that jump orbited the camera wildly instead of probing.
+    So motion counts from where the press landed, never from where the pointer was before
+    it. A press becomes a drag once it has moved more than CLICK_SLOP pixels in all; only
+    then do its moves turn the camera.
+    """
+
+    def __init__(self) -> None:
+        self.last: tuple[float, float] | None = None
+        self.travel = 0.0
+
+    def press(self, pos: tuple[float, float]) -> None:
+        self.last, self.travel = (float(pos[0]), float(pos[1])), 0.0
+
+    def move(self, pos: tuple[float, float]) -> tuple[float, float]:
+        """The motion to apply to the camera this frame ((0, 0) while still a click)."""
+        if self.last is None:
+            self.press(pos)
+        dx, dy = float(pos[0]) - self.last[0], float(pos[1]) - self.last[1]
+        self.last = (float(pos[0]), float(pos[1]))
+        self.travel += abs(dx) + abs(dy)
+        return (dx, dy) if self.travel > CLICK_SLOP else (0.0, 0.0)
+
+    @property
+    def is_click(self) -> bool:
+        return self.travel <= CLICK_SLOP

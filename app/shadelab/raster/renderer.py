@@ -479,7 +479,8 @@ class Renderer:
             shadows.heatmap()
         if settings.show_volumes:
             for i, light in enumerate(lights):
-                shadows.draw_translucent(view, shadows.volumes(scene, gpu_meshes, i, light))
+                shadows.draw_translucent(target, view,
+                                         shadows.volumes(scene, gpu_meshes, i, light))
         if settings.show_silhouettes:
             for i, light in enumerate(lights):
                 shadows.draw_silhouettes(view, shadows.volumes(scene, gpu_meshes, i, light))

@@ -33,6 +33,9 @@ from shadelab.shading.lights import light_kind
 
 OFFSET_FRACTION = 1e-3  # open casters' volumes start this share of the scene's diagonal away
 VOLUME_COLOR = (0.25, 0.45, 1.0, 0.18)  # translucent volumes (linear RGB, alpha)
+# glPolygonOffset(factor, units) for the drawn volumes: behind the caster surface they lie on
+# (factor: the slope of grazing faces at the terminator; units: 24-bit depth steps)
+VOLUME_DEPTH_OFFSET = (1.0, 4.0)
 SILHOUETTE_COLOR = (1.0, 0.85, 0.1, 1.0)
 HEAT_LEVELS = 8  # stencil counts 1..8 get their own color; above 8 shows as 8
 # kt-filtered shadows: with transparent casters the stencil splits into a 4-bit volume counter
@@ -306,20 +309,31 @@ class ShadowVolumes:
         ctx.depth_func = "<"
         self.stencil_off()
 
-    def draw_translucent(self, view, volumes: list[CasterVolume]) -> None:
-        """Draw the volumes themselves, translucent, depth-tested against the scene."""
+    def draw_translucent(self, target, view, volumes: list[CasterVolume]) -> None:
+        """Draw the volumes themselves, translucent, depth-tested against the scene and pushed
+        back by a polygon offset: the near cap and the sides' first rows lie on the caster's
+        own surface, and drawn at its depth they z-fought with it (a sawtooth terminator). No
+        depth is written, so volumes never hide each other or what is drawn after them."""
         GL = _gl()
         ctx = self.ctx
         ctx.enable_only(moderngl.DEPTH_TEST | moderngl.BLEND)
         ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
+        target.fbo.depth_mask = False
+        target.fbo.use()
         _ = ctx.error
         GL.glDisable(GL.GL_STENCIL_TEST)
         GL.glEnable(GL.GL_DEPTH_CLAMP)
+        GL.glEnable(GL.GL_POLYGON_OFFSET_FILL)
+        GL.glPolygonOffset(*VOLUME_DEPTH_OFFSET)
         set_uniform(self.program, "u_clip_from_world", gl_matrix(view.clip_from_world))
         set_uniform(self.program, "u_color", VOLUME_COLOR)
-        for caster in volumes:
-            caster.vao.render(moderngl.TRIANGLES)
-        GL.glDisable(GL.GL_DEPTH_CLAMP)
+        try:
+            for caster in volumes:
+                caster.vao.render(moderngl.TRIANGLES)
+        finally:
+            GL.glDisable(GL.GL_POLYGON_OFFSET_FILL)
+            GL.glDisable(GL.GL_DEPTH_CLAMP)
+            target.fbo.depth_mask = True
 
     def draw_silhouettes(self, view, volumes: list[CasterVolume]) -> None:
         """Silhouette edges as lines, on top of everything."""

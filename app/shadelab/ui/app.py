@@ -153,7 +153,8 @@ class Viewer:
     options: ViewerOptions
     viewport: object = None            # shadelab.ui.viewport.Viewport, made in post_init
     gpu: object = None                 # shadelab.ui.gpu_side.GpuSide: serves state.gpu
-    drag: float = 0.0                  # pixels moved since the mouse went down
+    pointer: camera_control.PointerDrag = field(  # the press over the viewport: click or drag
+        default_factory=camera_control.PointerDrag)
     autosave: Autosave = field(default_factory=Autosave)  # the session file, now and then
     title: str = ""
     recorder: FrameRecorder = field(default_factory=FrameRecorder)  # frame times, the bench
@@ -244,19 +245,19 @@ class Viewer:
                                | imgui.ButtonFlags_.mouse_button_middle)
         io = imgui.get_io()
         camera = state.scene.camera
-        if imgui.is_item_activated():
-            self.drag = 0.0
+        pointer = (io.mouse_pos.x, io.mouse_pos.y)
+        if imgui.is_item_activated():  # motion counts from here, not from the last position
+            self.pointer.press(pointer)
         if imgui.is_item_active():
-            dx, dy = io.mouse_delta.x, io.mouse_delta.y
-            self.drag += abs(dx) + abs(dy)
-            if self.drag > camera_control.CLICK_SLOP and (dx or dy) and not gizmos.capturing():
+            dx, dy = self.pointer.move(pointer)
+            if (dx or dy) and not gizmos.capturing():
                 camera_control.drag(camera, dx, dy, imgui.is_mouse_down(imgui.MouseButton_.left),
                                     size[1], size[1], size[0])
                 state.mark_edited()
         if imgui.is_item_hovered() and io.mouse_wheel:
             camera_control.zoom(camera, io.mouse_wheel)
             state.mark_edited()
-        if imgui.is_item_deactivated() and self.drag <= camera_control.CLICK_SLOP \
+        if imgui.is_item_deactivated() and self.pointer.is_click \
                 and imgui.is_mouse_released(imgui.MouseButton_.left):
             mouse = io.mouse_pos
             return mouse.x - origin.x, mouse.y - origin.y
