@@ -41,17 +41,18 @@ def draw(viewer, display_size: tuple[int, int]) -> bool:
     sync(state)
     track_side_panel_job(state)
     name = current(state)
-    wipe = state.wipe and state.wipe_pipeline in PIPELINES and state.wipe_pipeline != name
+    wipe = (state.view.wipe and state.view.wipe_pipeline in PIPELINES
+            and state.view.wipe_pipeline != name)
     if name not in OFFLINE and not wipe:
         if view.runner is not None and view.runner.running and view.name in OFFLINE:
             view.runner.cancel()
         view.key = None
         return False
-    scale = state.render_scale
+    scale = state.view.render_scale
     size = (max(int(display_size[0] * scale), 8), max(int(display_size[1] * scale), 8))
     if state.frame < 3:     # the dock layout settles over the first frames: no job at 16x16
         return True
-    other = state.wipe_pipeline if wipe else None
+    other = state.view.wipe_pipeline if wipe else None
     offline = [n for n in (name, other) if n in OFFLINE]
     if offline:
         poll(state, offline[0], size)
@@ -70,12 +71,12 @@ def draw(viewer, display_size: tuple[int, int]) -> bool:
         clicked = viewer._image_with_input(_blank(viewer), display_size)
     if wipe:
         tex_b = _texture(viewer, other, size, offline)
-        x = origin.x + state.wipe_position * display_size[0]
+        x = origin.x + state.view.wipe_position * display_size[0]
         if tex_b is not None:
             draw_list.add_image(imgui.ImTextureRef(tex_b.glo), imgui.ImVec2(x, origin.y),
                                 imgui.ImVec2(origin.x + display_size[0],
                                              origin.y + display_size[1]),
-                                imgui.ImVec2(state.wipe_position, _v(other, 0)),
+                                imgui.ImVec2(state.view.wipe_position, _v(other, 0)),
                                 imgui.ImVec2(1.0, _v(other, 1)))
         draw_list.add_line(imgui.ImVec2(x, origin.y), imgui.ImVec2(x, origin.y + display_size[1]),
                            0xFFFFFFFF, 3.0)
@@ -123,7 +124,7 @@ def _texture(viewer, name: str, size: tuple[int, int], offline: list):
             return None
         pane = vp.pane("pipeline_radiosity", size)
         vp.draw_colored_triangles(pane, state.scene, viewport_soup(state, view.soup))
-        if state.show_wireframe or state.radiosity_patches:
+        if state.view.show_wireframe or state.view.radiosity_patches:
             vp.draw_lines(pane, patch_edges(view.soup), exposure)
         if view.shooter is not None and not view.stats.get("done"):
             vp.draw_lines(pane, shooter_lines(view.shooter), exposure, depth_test=False)
