@@ -32,9 +32,10 @@ from shadelab.ui.pipelines import (
     view_of,
 )
 from shadelab.ui.radiosity_view import viewport_soup
+from shadelab.ui.viewport_host import ViewportHost
 
 
-def draw(viewer, display_size: tuple[int, int]) -> bool:
+def draw(viewer: ViewportHost, display_size: tuple[int, int]) -> bool:
     """The main viewport in an offline pipeline or with the wipe; False: the raster path."""
     state = viewer.state
     view = view_of(state)
@@ -64,11 +65,11 @@ def draw(viewer, display_size: tuple[int, int]) -> bool:
         view.key = None
     tex_a = _texture(viewer, name, size, offline)
     origin = imgui.get_cursor_screen_pos()
-    clicked = viewer._image_with_input(tex_a, display_size) if tex_a is not None else None
+    clicked = viewer.image_with_input(tex_a, display_size) if tex_a is not None else None
     draw_list = imgui.get_window_draw_list()
     if tex_a is None:
         imgui.set_cursor_screen_pos(origin)
-        clicked = viewer._image_with_input(_blank(viewer), display_size)
+        clicked = viewer.image_with_input(_blank(viewer), display_size)
     if wipe:
         tex_b = _texture(viewer, other, size, offline)
         x = origin.x + state.view.wipe_position * display_size[0]
@@ -101,14 +102,14 @@ def _v(name: str, end: int) -> float:
     return 1.0 - end
 
 
-def _blank(viewer):
+def _blank(viewer: ViewportHost):
     vp = viewer.viewport
     if "pipeline_blank" not in vp.images:
         vp.upload_image("pipeline_blank", np.zeros((8, 8, 3), np.uint8))
     return vp.images["pipeline_blank"]
 
 
-def _texture(viewer, name: str, size: tuple[int, int], offline: list):
+def _texture(viewer: ViewportHost, name: str, size: tuple[int, int], offline: list):
     """The display texture of pipeline ``name`` (raster: rendered now if its inputs changed)."""
     state, vp = viewer.state, viewer.viewport
     view = view_of(state)
@@ -143,7 +144,7 @@ def _texture(viewer, name: str, size: tuple[int, int], offline: list):
     return vp.panes[pane_key].display
 
 
-def _screenshot_pipeline(viewer, texture) -> None:
+def _screenshot_pipeline(viewer: ViewportHost, texture) -> None:
     """The S key in an offline pipeline: the pipeline's image as a PNG."""
     from PIL import Image
 
