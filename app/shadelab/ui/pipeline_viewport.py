@@ -131,7 +131,7 @@ def _texture(viewer: ViewportHost, name: str, size: tuple[int, int], offline: li
             vp.draw_lines(pane, shooter_lines(view.shooter), exposure, depth_test=False)
         return vp.present(pane, exposure)
     shading, visibility = RASTER[name]
-    key = (repr(state.scene), size, name)
+    key = (id(state.scene), state.scene_version, state.scene.version, size, name)
     pane_key = f"pipeline_{name}"
     if view.raster_key.get(name) != key or pane_key not in vp.panes:
         view.raster_key[name] = key

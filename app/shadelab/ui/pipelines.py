@@ -80,13 +80,15 @@ class JobRecord:
 
 
 def job_key(state: AppState, name: str, size: tuple[int, int]) -> tuple:
-    """What an offline image depends on: radiosity is view-independent (no camera, no size)."""
+    """What an offline image depends on: radiosity is view-independent (no camera, no size:
+    the edit key of the objects, materials and radiosity settings only); the others key on the
+    whole scene by its edit counter and which scene it is, as the viewport does
+    (:meth:`shadelab.ui.app.Viewer.frame_key`)."""
     scene = state.scene
     if name == "radiosity":
-        return (name, repr(scene.objects), repr(scene.materials), repr(scene.radiosity),
-                scene.base_dir)
+        return (name, scene.edit_key("objects", "materials", "radiosity"), scene.base_dir)
     spp = state.offline.spp if name == "pathtrace" else scene.raytrace.spp
-    return (name, repr(scene), size, spp)
+    return (name, id(scene), state.scene_version, scene.version, size, spp)
 
 
 def scene_for(state: AppState, name: str):
