@@ -4,6 +4,7 @@ material's uniforms by one route."""
 
 from __future__ import annotations
 
+import ast
 import math
 import re
 import struct
@@ -32,6 +33,10 @@ def test_each_kind_string_is_one_class_with_its_code():
     assert codes.LIGHT_KIND_CODES == {"point": 0, "directional": 1, "spot": 2}
     table = packing.light_table([Light(kind=k, direction=(0, -1, 0)) for k in LIGHT_KINDS])
     assert table[:, packing.L_KIND].tolist() == [0.0, 1.0, 2.0]
+    kinds = {k: light_kind(Light(kind=k)) for k in LIGHT_KINDS}
+    assert {k: (v.at_infinity, v.aimed, v.has_cone) for k, v in kinds.items()} == {
+        "point": (False, False, False), "directional": (True, True, False),
+        "spot": (False, True, True)}
 
 
 def test_point_light_vectors_and_attenuation_closed_form():
@@ -83,7 +88,8 @@ def test_reflectance_and_the_material_uniforms_one_route():
     np.testing.assert_allclose(folded["u_ambient"], (0.01, 0.005, 0.22), rtol=1e-6)
 
 
-@pytest.mark.parametrize("folder", ["raster", "raytrace", "radiosity", "shading"])
+@pytest.mark.parametrize("folder", ["raster", "raytrace", "radiosity", "shading", "pipelines",
+                                    "lab", "bench", "studies", "ui"])
 def test_rho_is_computed_in_packing_only(folder):
     """No kd * Od outside shading/packing.py (the reference's per-point equation aside)."""
     pattern = re.compile(r"\.kd\s*\*|np\.multiply\(\w+\.kd|\bkd\s*\*\s*od\b|\bkd\[[^]]*\]\s*\*")
@@ -91,3 +97,31 @@ def test_rho_is_computed_in_packing_only(folder):
     found = [f"{p.name}:{i}" for p in (PACKAGE / folder).rglob("*.py") if p.name not in skip
              for i, line in enumerate(p.read_text().splitlines(), 1) if pattern.search(line)]
     assert found == []
+
+
+def _kind_string_tests(path: Path) -> list[str]:
+    """``<x>.kind == "spot"``, ``<x>.kind in ("point", "spot")``... with a light kind's name."""
+    found = []
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if not isinstance(node, ast.Compare):
+            continue
+        sides = [node.left, *node.comparators]
+        if not any(isinstance(s, ast.Attribute) and s.attr == "kind" for s in sides):
+            continue
+        for side in sides:
+            items = side.elts if isinstance(side, (ast.Tuple, ast.List, ast.Set)) else [side]
+            if any(isinstance(i, ast.Constant) and i.value in LIGHT_KINDS for i in items):
+                found.append(f"{path.relative_to(PACKAGE)}:{node.lineno}")
+                break
+    return found
+
+
+def test_light_kinds_are_tested_through_their_classes_only():
+    """No light kind string compared outside shading/lights.py and scene/ (the preset's own
+    names): the viewer, the probe and the renderers ask ``light_kind(light)``
+    (``at_infinity``, ``aimed``, ``has_cone``, ``to_light``...). geometry/silhouette.py takes
+    the kind as a string argument (a pure layer below shading) and is not a ``.kind`` test."""
+    files = [p for p in PACKAGE.rglob("*.py")
+             if p.relative_to(PACKAGE).parts[0] != "scene" and p.name != "lights.py"]
+    assert any(p.name == "gizmos.py" for p in files) and any(p.name == "probe.py" for p in files)
+    assert [hit for p in sorted(files) for hit in _kind_string_tests(p)] == []

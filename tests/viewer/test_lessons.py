@@ -3,6 +3,7 @@ lesson is one line naming the step and the key, and a step sets exactly its view
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -13,6 +14,15 @@ from shadelab.errors import ShadeLabError
 from shadelab.lab.lesson import SHOW_TOGGLES, LessonRun, go_to, list_lessons, load_lesson
 from shadelab.lab.state import AppState
 from shadelab.scene import load_preset
+
+
+def _bare_env() -> dict:
+    """No display, a plain PATH; the inherited PYTHONPATH is kept (the code under test)."""
+    env = {"PATH": "/usr/bin:/bin", "DISPLAY": ""}
+    if "PYTHONPATH" in os.environ:
+        env["PYTHONPATH"] = os.environ["PYTHONPATH"]
+    return env
+
 
 GOOD_STEP = '[[steps]]\ntitle = "Ambient"\ncaption = "I = Ia ka"\npreset = "lecture"\n'
 
@@ -55,7 +65,7 @@ def test_a_broken_lesson_on_the_command_line_exits_2_with_one_line(tmp_path):
     path.write_text('name = "x"\n' + GOOD_STEP + 'show = ["xray"]\n')
     run = subprocess.run([sys.executable, "-m", "shadelab", "view", "--lesson", str(path),
                           "--frames", "1"], capture_output=True, text=True, timeout=120,
-                         env={"PATH": "/usr/bin:/bin", "DISPLAY": ""})
+                         env=_bare_env())
     assert run.returncode == 2
     assert len(run.stderr.strip().splitlines()) == 1 and "xray" in run.stderr
 
@@ -118,6 +128,6 @@ def test_a_file_that_cannot_open_is_said_at_once_without_asking_about_the_edits(
 def test_a_bad_lesson_step_exits_2_with_one_line(argv, message):
     run = subprocess.run([sys.executable, "-m", "shadelab", "view", *argv, "--frames", "1"],
                          capture_output=True, text=True, timeout=120,
-                         env={"PATH": "/usr/bin:/bin", "DISPLAY": ""})
+                         env=_bare_env())
     assert run.returncode == 2
     assert len(run.stderr.strip().splitlines()) == 1 and message in run.stderr

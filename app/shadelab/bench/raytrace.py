@@ -16,6 +16,7 @@ from shadelab.raytrace.surface import TraceContext
 from shadelab.raytrace.whitted import iter_raytrace
 from shadelab.scene.camera import primary_rays, tan_half_fov_y
 from shadelab.scene.preset import load_preset
+from shadelab.shading.packing import reflectance
 from shadelab.timing import median_time
 
 
@@ -141,7 +142,7 @@ def _mitsuba(size, spp: int, repeats: int) -> dict:
     for m in scene_meshes(scene):
         material = scene.materials[m.material]
         props = mi.Properties()
-        rho = [material.kd * c for c in material.Od]
+        rho = [float(c) for c in reflectance(material)]
         props["bsdf"] = mi.load_dict({"type": "diffuse", "reflectance": {
             "type": "rgb", "value": rho}})
         if max(material.emission) > 0.0:

@@ -218,15 +218,15 @@ def run_view(args: argparse.Namespace) -> int:
         state.history.files[0] = state.file_meta()
     if notes:
         state.error = notes[-1]
-    state.compare, state.diff_enabled = args.compare, args.diff
-    state.presenter, state.show_help = args.presenter, args.help_overlay
-    state.show_wireframe, state.show_normals = args.wireframe, args.normals
+    state.view.compare, state.view.diff_enabled = args.compare, args.diff
+    state.view.presenter, state.view.show_help = args.presenter, args.help_overlay
+    state.view.show_wireframe, state.view.show_normals = args.wireframe, args.normals
     if run is not None:   # after the view flags: the step's own toggles (show = [...]) win
         from shadelab.lab.lesson import go_to
 
-        state.lesson = run
+        state.walk.lesson = run
         go_to(state, args.step - 1)
-    state.msaa = args.msaa
+    state.view.msaa = args.msaa
     if exercise is not None:
         from shadelab.ui.exercise_panel import open_exercise
 

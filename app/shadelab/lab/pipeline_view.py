@@ -61,15 +61,15 @@ class PipelineView:
 
 
 def view_of(state) -> PipelineView:
-    if state.pipeline_view is None:
-        state.pipeline_view = PipelineView()
-    return state.pipeline_view
+    if state.view.pipeline_view is None:
+        state.view.pipeline_view = PipelineView()
+    return state.view.pipeline_view
 
 
 def current(state) -> str:
-    """The pipeline shown: ``state.pipeline``, or the raster one the scene's settings name."""
-    if state.pipeline in PIPELINES:
-        return state.pipeline
+    """The pipeline shown: ``state.view.pipeline``, or the raster one the scene's settings name."""
+    if state.view.pipeline in PIPELINES:
+        return state.view.pipeline
     render = state.scene.render
     if render.visibility == "painter":
         return "painter"
@@ -81,14 +81,14 @@ def set_pipeline(state, name: str) -> None:
     if name not in PIPELINES:
         state.error = f"pipeline '{name}': expected one of {', '.join(PIPELINES)}"
         return
-    state.pipeline = name
+    state.view.pipeline = name
     sync(state)
 
 
 def sync(state) -> None:
     """Write a newly chosen raster pipeline into the scene (once per choice)."""
     view = view_of(state)
-    name = state.pipeline
+    name = state.view.pipeline
     if name in RASTER and view.applied != name:
         shading, visibility = RASTER[name]
         render = state.scene.render

@@ -23,6 +23,7 @@ from shadelab.geometry.mesh import MeshData, scene_meshes
 from shadelab.raytrace.accel import build_accel, scene_geometry
 from shadelab.scene.camera import primary_rays
 from shadelab.scene.model import Scene
+from shadelab.shading.lights import light_kind
 from shadelab.shading.reference import ShadeTerms, halfway, normalize, reflect_light, shade_terms
 
 
@@ -118,7 +119,7 @@ def probe_shadows(scene: Scene, point: np.ndarray, geometric_normal: np.ndarray,
     origin = np.asarray(point, dtype=np.float64) + ctx.eps * geometric_normal
     out = []
     for light in lights:
-        if light.kind == "directional":
+        if light_kind(light).at_infinity:
             d, tmax = normalize(-np.asarray(light.direction, dtype=np.float64)), T_INF
         else:
             delta = np.asarray(light.position, dtype=np.float64) - origin

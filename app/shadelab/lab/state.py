@@ -145,41 +145,6 @@ class LessonState:
 SUB_STATES = {"view": ViewState, "probe": ProbeState, "offline": OfflineState,
               "studies": StudyState, "walk": LessonState}
 
-# Remaining for the pipelines merge: the flat names that lab/pipeline_view.py, ui/pipelines.py,
-# ui/offline.py, ui/pipeline_viewport.py, ui/render_panel.py and cli/view.py still read and
-# write (``state.compare`` is ``state.view.compare``). Delete an entry once no file uses it,
-# and this table with :class:`_In` once it is empty.
-REMAINING_FLAT_NAMES = {
-    **{name: ("view", name) for name in (
-        "compare", "diff_enabled", "msaa", "pipeline", "pipeline_view", "presenter",
-        "radiosity_patches", "render_scale", "show_help", "show_normals", "show_wireframe",
-        "viewport_size", "wipe", "wipe_pipeline", "wipe_position")},
-    "job": ("offline", "runner"), "job_kind": ("offline", "kind"),
-    "job_size": ("offline", "size"), "job_spp": ("offline", "spp"),
-    "job_compare": ("offline", "comparison"), "job_raster": ("offline", "raster"),
-    "job_kinds": ("offline", "kinds"), "job_version": ("offline", "version"),
-    "job_scene": ("offline", "scene"), "job_size_px": ("offline", "size_px"),
-    **{name: ("offline", name) for name in (
-        "ray_tree", "ray_tree_pixel", "radiosity_soup", "show_radiosity", "overlay_version")},
-    "lesson": ("walk", "lesson"),
-}
-
-
-class _In:
-    """Remaining for the pipelines merge: a flat AppState name of a sub-state field
-    (:data:`REMAINING_FLAT_NAMES`)."""
-
-    def __init__(self, part: str, name: str):
-        self.part, self.name = part, name
-
-    def __get__(self, obj, objtype=None):
-        if obj is None:
-            return self
-        return getattr(getattr(obj, self.part), self.name)
-
-    def __set__(self, obj, value) -> None:
-        setattr(getattr(obj, self.part), self.name, value)
-
 
 # ---------------------------------------------------------------- the app state
 
@@ -404,8 +369,3 @@ class AppState:
         name = self.scene.name or Path(self.source).stem
         return f"ShadeLab - {name}{' *' if self.dirty else ''}"
 
-
-# Remaining for the pipelines merge (see REMAINING_FLAT_NAMES).
-for _name, (_part, _field) in REMAINING_FLAT_NAMES.items():
-    setattr(AppState, _name, _In(_part, _field))
-del _name, _part, _field

@@ -26,6 +26,7 @@ from shadelab.pipelines.base import TRIANGLES, BasePipeline
 from shadelab.pipelines.registry import register
 from shadelab.progress import Progress
 from shadelab.scene.model import Scene
+from shadelab.shading.packing import reflectance
 
 RADIOSITY_CHUNK_S = 0.05     # seconds of shooting between two viewer updates
 _RADIOSITY_CACHE: dict = {}  # worker process: geometry key -> (patches, form factors, token)
@@ -127,7 +128,7 @@ def _reflectance(scene: Scene, patches) -> tuple[np.ndarray, np.ndarray]:
     for index, surface in enumerate(patches.surfaces):
         material = scene.materials[surface.material]
         mask = patches.surface == index
-        rho[mask] = material.kd * np.asarray(material.Od, float)
+        rho[mask] = reflectance(material)
         emission[mask] = material.emission
     return rho, emission
 

@@ -86,6 +86,7 @@ class Checked:
         object.__setattr__(self, "_stamp", next(_STAMPS))
 
 
+_SCENE_PARTS = ("camera", "lights", "materials", "objects", "render", "raytrace", "radiosity")
 _STAMPS = itertools.count(1)   # edit stamps, unique in the process (next() is atomic)
 _MISSING = object()
 
@@ -282,6 +283,24 @@ class Scene(Checked):
             object.__setattr__(self, "_signature", signature)
             object.__setattr__(self, "_version", self.__dict__.get("_version", -1) + 1)
         return self.__dict__["_version"]
+
+    def edit_key(self, *parts: str) -> tuple:
+        """A key of some parts of the scene (``"camera"``, ``"lights"``, ``"materials"``,
+        ``"objects"``, ``"render"``, ``"raytrace"``, ``"radiosity"``): it changes with any edit
+        :attr:`version` counts in those parts, and with no other (work that does not depend on
+        the camera keeps its key while the camera moves). A copy has its original's key."""
+        key = []
+        for part in parts:
+            if part not in _SCENE_PARTS:
+                raise ValueError(f"edit_key: unknown part '{part}' (expected one of "
+                                 f"{', '.join(_SCENE_PARTS)})")
+            value = getattr(self, part)
+            if isinstance(value, dict):
+                key.append(tuple(value))  # names too: a material renamed is an edit
+                value = list(value.values())
+            nodes = value if isinstance(value, list) else [value]
+            key.append(tuple(getattr(n, "_stamp", id(n)) for n in nodes))
+        return tuple(key)
 
     def active_lights(self) -> list[Light]:
         return [light for light in self.lights if light.enabled]

@@ -76,6 +76,7 @@ class LightKind:
     code: ClassVar[int]
     at_infinity: ClassVar[bool] = False   # directional: no position, no f_att
     aimed: ClassVar[bool] = False         # its ``direction`` must be a non-zero vector
+    has_cone: ClassVar[bool] = False      # spot: ``cone_angle`` and ``spot_exponent`` apply
 
     def __init__(self, light: Light):
         self.light = light
@@ -141,6 +142,7 @@ class SpotLight(PointLight):
     kind = "spot"
     code = 2
     aimed = True
+    has_cone = True
 
     def spot(self, to_light: np.ndarray) -> np.ndarray:
         light = self.light

@@ -263,9 +263,6 @@ class Viewer:
             return mouse.x - origin.x, mouse.y - origin.y
         return None
 
-    # Remaining for the pipelines merge: ui/pipeline_viewport.py still calls the old name.
-    _image_with_input = image_with_input
-
     def frame_key(self, size: tuple[int, int]) -> tuple:
         """Everything the viewport image depends on; an unchanged key reuses the last image.
 

@@ -16,6 +16,7 @@ from imgui_bundle import imgui, imguizmo
 
 from shadelab.lab.state import AppState
 from shadelab.scene.camera import clip_from_view, tan_half_fov_y, view_from_world
+from shadelab.shading.lights import light_kind
 
 GIZMO = imguizmo.im_guizmo
 GIZMO_SIZE = 0.12            # ImGuizmo's size, share of clip space
@@ -89,7 +90,7 @@ def draw(state: AppState, origin, size: tuple[int, int]) -> bool:
     light = state.scene.lights[selected]
     forward = np.subtract(cam.target, cam.eye) / span
     depth = float(np.dot(np.subtract(light.position, cam.eye), forward))
-    if light.kind == "directional" or (depth <= cam.near and not _using):
+    if light_kind(light).at_infinity or (depth <= cam.near and not _using):
         # (a light beside or behind the eye: ImGuizmo returns early there and left its clip
         # rect on the window's draw list, which hid the lesson caption drawn after it)
         _using = False
@@ -119,7 +120,8 @@ def _draw_glyph(draw_list, project, origin, light, color: int, scale: float, spa
         q = project(p)
         return None if q is None else imgui.ImVec2(origin.x + q[0], origin.y + q[1])
 
-    if light.kind == "directional":
+    kind = light_kind(light)
+    if kind.at_infinity:
         d = np.asarray(light.direction, dtype=np.float64)
         d = d / max(np.linalg.norm(d), 1e-12)
         start = screen(np.zeros(3) - d * 0.3 * span)
@@ -138,7 +140,7 @@ def _draw_glyph(draw_list, project, origin, light, color: int, scale: float, spa
                                         centre.y + r * 0.8 * math.sin(a)),
                            imgui.ImVec2(centre.x + r * 1.5 * math.cos(a),
                                         centre.y + r * 1.5 * math.sin(a)), color, thickness)
-    if light.kind == "spot":
+    if kind.has_cone:
         d = np.asarray(light.direction, dtype=np.float64)
         d = d / max(np.linalg.norm(d), 1e-12)
         length = 0.25 * span

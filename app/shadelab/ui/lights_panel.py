@@ -13,6 +13,7 @@ from shadelab.scene.model import (
     Light,
 )
 from shadelab.shading import reference
+from shadelab.shading.lights import light_kind
 from shadelab.ui.layout import plot_size
 from shadelab.ui.panels import (
     combo,
@@ -27,15 +28,16 @@ from shadelab.ui.ranges import field_slider
 
 
 def _light_rows(light: Light, span: float) -> list[tuple]:
+    kind = light_kind(light)
     rows: list[tuple] = [("kind", combo, LIGHT_KINDS)]
-    if light.kind in ("point", "spot"):
+    if not kind.at_infinity:
         rows.append(("position", vec3, span * 0.005))
-    if light.kind in ("directional", "spot"):
+    if kind.aimed:
         rows.append(("direction", vec3, 0.01))
     rows.append(("Ip", intensity_color))
-    if light.kind == "spot":
+    if kind.has_cone:
         rows += [("cone_angle", field_slider(Light)), ("spot_exponent", field_slider(Light))]
-    if light.kind != "directional":
+    if not kind.at_infinity:
         rows.append(("attenuation", combo, ATTENUATION_MODES))
         if light.attenuation == "lecture":
             rows += [(c, field_slider(Light)) for c in ("c1", "c2", "c3")]
@@ -89,7 +91,7 @@ def draw_lights_panel(state: AppState) -> bool:
         if imgui.tree_node_ex(f"{label} ({light.kind})###node",
                               imgui.TreeNodeFlags_.default_open if i == 0 else 0):
             edited |= edit_fields(light, _light_rows(light, span))
-            if light.kind != "directional" and light.attenuation != "none":
+            if not light_kind(light).at_infinity and light.attenuation != "none":
                 _draw_attenuation_plot(state, i, light)
             if imgui.small_button("Remove light"):
                 remove = i

@@ -20,9 +20,9 @@ SAMPLES = (1, 4, 16, 64, 256)
 
 
 def kinds(state: AppState):
-    if state.job_kinds is None:
-        state.job_kinds = available_jobs()
-    return state.job_kinds
+    if state.offline.kinds is None:
+        state.offline.kinds = available_jobs()
+    return state.offline.kinds
 
 
 _finder: dict = {}  # the thread looking for the renderers, and what it found
@@ -32,8 +32,8 @@ def kinds_when_found(state: AppState):
     """The job kinds, or None while a thread still looks for them: finding them imports
     every renderer (numba, embree; a second or more), which the first frame must not wait
     for."""
-    if state.job_kinds is not None:
-        return state.job_kinds
+    if state.offline.kinds is not None:
+        return state.offline.kinds
     thread = _finder.get("thread")
     if thread is None:
         def find() -> None:
@@ -46,8 +46,8 @@ def kinds_when_found(state: AppState):
         thread.start()
     if thread.is_alive():
         return None
-    state.job_kinds = _finder.get("kinds") or available_jobs()
-    return state.job_kinds
+    state.offline.kinds = _finder.get("kinds") or available_jobs()
+    return state.offline.kinds
 
 
 def start_job(state: AppState, index: int) -> None:
@@ -58,17 +58,18 @@ def start_job(state: AppState, index: int) -> None:
         return
     scene = clone_scene(state.scene)
     if kind.samples:
-        scene.raytrace.spp = state.job_spp
+        scene.raytrace.spp = state.offline.spp
     size = _job_size(state)
     # the raster view to compare with: drawn by the GL side before the panels' next frame
     state.gpu.request("job_raster", "raster", scene=scene, size=size,
                       shading=kind.raster_shading, specular=scene.render.specular)
-    state.job_raster = None
-    state.job_kind, state.job_version, state.job_compare = index, -1, None
-    state.job_scene, state.job_size_px = scene, size
-    state.ray_tree = state.ray_tree_pixel = None
-    state.overlay_version += 1
-    state.job.start(kind.label, lambda: kind.make(scene, size), call=(kind.make, scene, size))
+    state.offline.raster = None
+    state.offline.kind, state.offline.version, state.offline.comparison = index, -1, None
+    state.offline.scene, state.offline.size_px = scene, size
+    state.offline.ray_tree = state.offline.ray_tree_pixel = None
+    state.offline.overlay_version += 1
+    state.offline.runner.start(kind.label, lambda: kind.make(scene, size),
+                               call=(kind.make, scene, size))
 
 
 def start_job_by_label(state: AppState, label: str) -> None:
@@ -86,9 +87,9 @@ def start_job_by_label(state: AppState, label: str) -> None:
 
 
 def _job_size(state: AppState) -> tuple[int, int]:
-    """The job's image: state.job_size pixels high, at the viewport's aspect ratio."""
-    w, h = state.viewport_size if state.viewport_size[1] > 0 else (1, 1)
-    height = state.job_size
+    """The job's image: state.offline.size pixels high, at the viewport's aspect ratio."""
+    w, h = state.view.viewport_size if state.view.viewport_size[1] > 0 else (1, 1)
+    height = state.offline.size
     return max(int(round(height * w / max(h, 1))), 1), height
 
 
@@ -96,11 +97,11 @@ def _upload_results(state: AppState) -> None:
     """Re-upload the job's image, its raster partner and their difference when new."""
     raster = state.gpu.take("job_raster")
     if raster is not None:     # (the job's image, if already here, is compared again)
-        state.job_raster, state.job_version = raster, -1
-    latest, version = state.job.snapshot()
-    if latest is None or version == state.job_version:
+        state.offline.raster, state.offline.version = raster, -1
+    latest, version = state.offline.runner.snapshot()
+    if latest is None or version == state.offline.version:
         return
-    state.job_version = version
+    state.offline.version = version
     _take_solution(state, latest)
     if latest.image is None:
         return
@@ -108,16 +109,16 @@ def _upload_results(state: AppState) -> None:
     image = np.asarray(latest.image, dtype=np.float32)
     gpu = state.gpu
     gpu.upload("job_result", to_srgb8(image, exposure))
-    raster = state.job_raster
+    raster = state.offline.raster
     if raster is not None and raster.shape == image.shape:
         gpu.upload("job_raster", to_srgb8(raster, exposure))
         scale = max(float(np.abs(raster).max()) * exposure, 1e-6) * 0.1
         gpu.upload("job_diff", heat_map(image * exposure, raster * exposure, scale))
-        state.job_compare = difference(image, raster) | {"heat_full_scale": scale / exposure}
-        if not state.job.running:  # FLIP (~0.1 s at 128^2): once, on the final image
+        state.offline.comparison = difference(image, raster) | {"heat_full_scale": scale / exposure}
+        if not state.offline.runner.running:  # FLIP (~0.1 s at 128^2): once, on the final image
             from shadelab.studies.metrics import flip
 
-            state.job_compare["flip"] = flip(image, raster, exposure=exposure)
+            state.offline.comparison["flip"] = flip(image, raster, exposure=exposure)
 
 
 def _take_solution(state: AppState, latest) -> None:
@@ -126,8 +127,8 @@ def _take_solution(state: AppState, latest) -> None:
     if solution is not None and hasattr(solution, "display_meshes"):
         from shadelab.lab.overlays import radiosity_soup
 
-        state.radiosity_soup = radiosity_soup(solution.display_meshes())
-        state.overlay_version += 1
+        state.offline.radiosity_soup = radiosity_soup(solution.display_meshes())
+        state.offline.overlay_version += 1
 
 
 def _show(state: AppState, key: str, caption: str, width: float) -> tuple[int, int] | None:
@@ -158,22 +159,23 @@ def trace_tree(state: AppState, pixel: tuple[int, int]) -> None:
         state.error = f"ray tree not available ({exc})"
         return
     try:
-        state.ray_tree = trace_pixel_tree(state.job_scene, state.job_size_px, *pixel)
-        state.ray_tree_pixel = pixel
-        state.overlay_version += 1
+        offline = state.offline
+        offline.ray_tree = trace_pixel_tree(offline.scene, offline.size_px, *pixel)
+        state.offline.ray_tree_pixel = pixel
+        state.offline.overlay_version += 1
     except Exception as exc:  # shown in the app; the session goes on
         state.error = f"ray tree of pixel {pixel}: {exc}"
 
 
 def draw_ray_tree(state: AppState) -> None:
-    root = state.ray_tree
+    root = state.offline.ray_tree
     if root is None:
         return
-    imgui.text_wrapped(f"ray tree of pixel {state.ray_tree_pixel} (drawn in the viewport; "
+    imgui.text_wrapped(f"ray tree of pixel {state.offline.ray_tree_pixel} (drawn in the viewport; "
                f"total {_rgb(root.total())})")
     if imgui.small_button("Clear ray tree"):
-        state.ray_tree = None
-        state.overlay_version += 1
+        state.offline.ray_tree = None
+        state.offline.overlay_version += 1
         return
     flags = imgui.TableFlags_.borders | imgui.TableFlags_.row_bg | imgui.TableFlags_.scroll_y
     if imgui.begin_table("raytree", 4, flags, imgui.ImVec2(0, 160)):
@@ -188,7 +190,7 @@ def draw_ray_tree(state: AppState) -> None:
             imgui.text_wrapped("  " * depth + label)
             imgui.table_next_column()
             imgui.text_wrapped("miss" if node.end is None
-                       else object_label(state.job_scene, node.object))  # name (material)
+                       else object_label(state.offline.scene, node.object))  # name (material)
             imgui.table_next_column()
             imgui.text_wrapped(_rgb(node.weight))
             imgui.table_next_column()
@@ -220,25 +222,25 @@ def work_done(latest) -> str:
 
 def draw_offline_panel(state: AppState) -> bool:
     """Pick a renderer, run it off the UI thread, compare its image with the raster view."""
-    job, options = state.job, kinds_when_found(state)
+    job, options = state.offline.runner, kinds_when_found(state)
     if options is None:
         imgui.text_colored(panels.DIM_COLOR, "looking for the offline renderers ...")
         return False
     labels = [k.label + ("" if k.make else " (not available)") for k in options]
-    _, state.job_kind = imgui.combo("Renderer", state.job_kind, labels)
-    kind = options[state.job_kind]
+    _, state.offline.kind = imgui.combo("Renderer", state.offline.kind, labels)
+    kind = options[state.offline.kind]
     if kind.make is None:
         imgui.text_colored(panels.DIM_COLOR, f"not available: {kind.reason}")
-    index = SIZES.index(state.job_size) if state.job_size in SIZES else SIZES.index(256)
+    index = SIZES.index(state.offline.size) if state.offline.size in SIZES else SIZES.index(256)
     _, index = imgui.combo("Height (px)", index, [str(s) for s in SIZES])
-    state.job_size = SIZES[index]
+    state.offline.size = SIZES[index]
     if kind.samples:
-        index = SAMPLES.index(state.job_spp) if state.job_spp in SAMPLES else 0
+        index = SAMPLES.index(state.offline.spp) if state.offline.spp in SAMPLES else 0
         _, index = imgui.combo("Samples / pixel", index, [str(n) for n in SAMPLES])
-        state.job_spp = SAMPLES[index]
+        state.offline.spp = SAMPLES[index]
     imgui.begin_disabled(job.running or kind.make is None)
     if imgui.button("Start"):
-        start_job(state, state.job_kind)
+        start_job(state, state.offline.kind)
     imgui.end_disabled()
     imgui.same_line()
     imgui.begin_disabled(not job.running)
@@ -279,8 +281,8 @@ def draw_offline_panel(state: AppState) -> bool:
         _show(state, "job_raster", f"raster ({kind.raster_shading})", width)
         imgui.same_line()
         _show(state, "job_diff", "|difference|", width)
-    if state.job_compare:
-        c = state.job_compare
+    if state.offline.comparison:
+        c = state.offline.comparison
         imgui.text_wrapped(f"RMSE {c['rmse']:.4g}  max |diff| {c['max_abs']:.4g}  "
                    f"relative RMSE {c['relative_rmse']:.3%}")
         if "flip" in c:
@@ -295,8 +297,8 @@ def draw_offline_panel(state: AppState) -> bool:
                  if isinstance(v, (int, float, str, bool))}
         imgui.text_wrapped("  ".join(f"{k}: {v:.4g}" if isinstance(v, float) else f"{k}: {v}"
                                      for k, v in shown.items()))
-    if state.radiosity_soup is not None:
-        _, state.show_radiosity = imgui.checkbox("Show the radiosity solution in the viewport",
-                                                 state.show_radiosity)
+    if state.offline.radiosity_soup is not None:
+        _, state.offline.show_radiosity = imgui.checkbox(
+            "Show the radiosity solution in the viewport", state.offline.show_radiosity)
     draw_ray_tree(state)
     return False

@@ -32,26 +32,28 @@ from shadelab.ui.pipelines import (
     view_of,
 )
 from shadelab.ui.radiosity_view import viewport_soup
+from shadelab.ui.viewport_host import ViewportHost
 
 
-def draw(viewer, display_size: tuple[int, int]) -> bool:
+def draw(viewer: ViewportHost, display_size: tuple[int, int]) -> bool:
     """The main viewport in an offline pipeline or with the wipe; False: the raster path."""
     state = viewer.state
     view = view_of(state)
     sync(state)
     track_side_panel_job(state)
     name = current(state)
-    wipe = state.wipe and state.wipe_pipeline in PIPELINES and state.wipe_pipeline != name
+    wipe = (state.view.wipe and state.view.wipe_pipeline in PIPELINES
+            and state.view.wipe_pipeline != name)
     if name not in OFFLINE and not wipe:
         if view.runner is not None and view.runner.running and view.name in OFFLINE:
             view.runner.cancel()
         view.key = None
         return False
-    scale = state.render_scale
+    scale = state.view.render_scale
     size = (max(int(display_size[0] * scale), 8), max(int(display_size[1] * scale), 8))
     if state.frame < 3:     # the dock layout settles over the first frames: no job at 16x16
         return True
-    other = state.wipe_pipeline if wipe else None
+    other = state.view.wipe_pipeline if wipe else None
     offline = [n for n in (name, other) if n in OFFLINE]
     if offline:
         poll(state, offline[0], size)
@@ -63,19 +65,19 @@ def draw(viewer, display_size: tuple[int, int]) -> bool:
         view.key = None
     tex_a = _texture(viewer, name, size, offline)
     origin = imgui.get_cursor_screen_pos()
-    clicked = viewer._image_with_input(tex_a, display_size) if tex_a is not None else None
+    clicked = viewer.image_with_input(tex_a, display_size) if tex_a is not None else None
     draw_list = imgui.get_window_draw_list()
     if tex_a is None:
         imgui.set_cursor_screen_pos(origin)
-        clicked = viewer._image_with_input(_blank(viewer), display_size)
+        clicked = viewer.image_with_input(_blank(viewer), display_size)
     if wipe:
         tex_b = _texture(viewer, other, size, offline)
-        x = origin.x + state.wipe_position * display_size[0]
+        x = origin.x + state.view.wipe_position * display_size[0]
         if tex_b is not None:
             draw_list.add_image(imgui.ImTextureRef(tex_b.glo), imgui.ImVec2(x, origin.y),
                                 imgui.ImVec2(origin.x + display_size[0],
                                              origin.y + display_size[1]),
-                                imgui.ImVec2(state.wipe_position, _v(other, 0)),
+                                imgui.ImVec2(state.view.wipe_position, _v(other, 0)),
                                 imgui.ImVec2(1.0, _v(other, 1)))
         draw_list.add_line(imgui.ImVec2(x, origin.y), imgui.ImVec2(x, origin.y + display_size[1]),
                            0xFFFFFFFF, 3.0)
@@ -100,14 +102,14 @@ def _v(name: str, end: int) -> float:
     return 1.0 - end
 
 
-def _blank(viewer):
+def _blank(viewer: ViewportHost):
     vp = viewer.viewport
     if "pipeline_blank" not in vp.images:
         vp.upload_image("pipeline_blank", np.zeros((8, 8, 3), np.uint8))
     return vp.images["pipeline_blank"]
 
 
-def _texture(viewer, name: str, size: tuple[int, int], offline: list):
+def _texture(viewer: ViewportHost, name: str, size: tuple[int, int], offline: list):
     """The display texture of pipeline ``name`` (raster: rendered now if its inputs changed)."""
     state, vp = viewer.state, viewer.viewport
     view = view_of(state)
@@ -123,13 +125,13 @@ def _texture(viewer, name: str, size: tuple[int, int], offline: list):
             return None
         pane = vp.pane("pipeline_radiosity", size)
         vp.draw_colored_triangles(pane, state.scene, viewport_soup(state, view.soup))
-        if state.show_wireframe or state.radiosity_patches:
+        if state.view.show_wireframe or state.view.radiosity_patches:
             vp.draw_lines(pane, patch_edges(view.soup), exposure)
         if view.shooter is not None and not view.stats.get("done"):
             vp.draw_lines(pane, shooter_lines(view.shooter), exposure, depth_test=False)
         return vp.present(pane, exposure)
     shading, visibility = RASTER[name]
-    key = (repr(state.scene), size, name)
+    key = (id(state.scene), state.scene_version, state.scene.version, size, name)
     pane_key = f"pipeline_{name}"
     if view.raster_key.get(name) != key or pane_key not in vp.panes:
         view.raster_key[name] = key
@@ -142,7 +144,7 @@ def _texture(viewer, name: str, size: tuple[int, int], offline: list):
     return vp.panes[pane_key].display
 
 
-def _screenshot_pipeline(viewer, texture) -> None:
+def _screenshot_pipeline(viewer: ViewportHost, texture) -> None:
     """The S key in an offline pipeline: the pipeline's image as a PNG."""
     from PIL import Image
 

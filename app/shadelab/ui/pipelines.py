@@ -1,6 +1,6 @@
 """The lecture's pipelines as a viewport mode, and the wipe that compares two of them.
 
-``state.pipeline`` names one of :data:`PIPELINES`. The raster ones (z-buffer + Gouraud,
+``state.view.pipeline`` names one of :data:`PIPELINES`. The raster ones (z-buffer + Gouraud,
 z-buffer + Phong, list priority + Phong) set the scene's shading and visibility (an edit, so
 undo brings the last one back). The offline ones draw into the main viewport at its
 resolution: ray and path tracing coarse first (1/8, 1/4, 1/2, full) and refined in place,
@@ -80,19 +80,21 @@ class JobRecord:
 
 
 def job_key(state: AppState, name: str, size: tuple[int, int]) -> tuple:
-    """What an offline image depends on: radiosity is view-independent (no camera, no size)."""
+    """What an offline image depends on: radiosity is view-independent (no camera, no size:
+    the edit key of the objects, materials and radiosity settings only); the others key on the
+    whole scene by its edit counter and which scene it is, as the viewport does
+    (:meth:`shadelab.ui.app.Viewer.frame_key`)."""
     scene = state.scene
     if name == "radiosity":
-        return (name, repr(scene.objects), repr(scene.materials), repr(scene.radiosity),
-                scene.base_dir)
-    spp = state.job_spp if name == "pathtrace" else scene.raytrace.spp
-    return (name, repr(scene), size, spp)
+        return (name, scene.edit_key("objects", "materials", "radiosity"), scene.base_dir)
+    spp = state.offline.spp if name == "pathtrace" else scene.raytrace.spp
+    return (name, id(scene), state.scene_version, scene.version, size, spp)
 
 
 def scene_for(state: AppState, name: str):
     scene = clone_scene(state.scene)
     if name == "pathtrace":
-        scene.raytrace.spp = max(int(state.job_spp), 1)
+        scene.raytrace.spp = max(int(state.offline.spp), 1)
     return scene
 
 
@@ -193,12 +195,12 @@ def _take(state: AppState) -> None:
 
 def track_side_panel_job(state: AppState) -> None:
     """Log the offline panel's job (``--job NAME``) for ``--bench-json`` too."""
-    view, job = view_of(state), state.job
+    view, job = view_of(state), state.offline.runner
     if job is None or not job.started:
         return
     if view.offline_seen != job._job_id:
         view.offline_seen = job._job_id
-        view.log.append(JobRecord(job.name, tuple(state.job_size_px),
+        view.log.append(JobRecord(job.name, tuple(state.offline.size_px),
                                   since_start(job.started)))
         view._offline_record = view.log[-1]
     record = view._offline_record
@@ -211,8 +213,8 @@ def track_side_panel_job(state: AppState) -> None:
 
 def busy(state: AppState) -> bool:
     """An offline pipeline is still refining (``--frames`` counts after it)."""
-    view = state.pipeline_view
-    if view is None or state.pipeline not in OFFLINE or view.runner is None:
+    view = state.view.pipeline_view
+    if view is None or state.view.pipeline not in OFFLINE or view.runner is None:
         return False
     return view.wanted is not None or view.runner.running or view.version < 0
 
@@ -226,10 +228,10 @@ def warm(state: AppState) -> None:
     runner = view.ensure_runner()
     if runner.worker is not None:
         runner.worker.ensure()   # spawn now: the process imports while the window opens
-    if state.pipeline in OFFLINE:
+    if state.view.pipeline in OFFLINE:
         if runner.worker is not None:  # import + load that pipeline's kernels before frame 3
             runner.worker.tasks.put((0, pipeline_jobs.warm_pipeline, clone_scene(state.scene),
-                                     state.pipeline))
+                                     state.view.pipeline))
         return
     scene = clone_scene(state.scene)
     view.name = "warm-up"
@@ -241,7 +243,7 @@ def warm(state: AppState) -> None:
 
 def bench_report(state: AppState) -> dict:
     """``jobs`` (name, first_image_s, done_s from process start) and the refining fps."""
-    view = state.pipeline_view
+    view = state.view.pipeline_view
     if view is None:
         return {}
     track_side_panel_job(state)
@@ -365,7 +367,7 @@ def draw_ray_tree(state: AppState, draw_list, origin, display_size) -> None:
 
     miss = 0.3 * scene_diagonal(scene_meshes(scene))
     segments = tree_segments(view.ray_tree, miss, view.tree_depth)
-    thick = 4.0 if state.presenter else 3.0
+    thick = 4.0 if state.view.presenter else 3.0
     for kind, start, end, node in segments:
         pts, front = project(scene, display_size, np.stack([start, end]))
         if not front[1]:

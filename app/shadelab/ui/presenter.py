@@ -195,7 +195,7 @@ def caption_text(state: AppState) -> str:
     render = state.scene.render
     equation = EQUATION_BLINN if render.specular == "blinn" else EQUATION
     mode = f"{SHADING_LABELS[render.shading]} shading"
-    pipeline = getattr(state, "pipeline", "")
+    pipeline = state.view.pipeline
     if pipeline:
         mode += f", pipeline {pipeline}"
     if render.shadows != "none":

@@ -2,7 +2,7 @@
 visibility, the ray tracer, the path tracer and radiosity, and the material extras.
 
 Each control edits a field of the scene (undoable, autosaved, saved into the preset) or of the
-job (``state.job_spp``); slider ranges come from the field's spec in
+job (``state.offline.spp``); slider ranges come from the field's spec in
 :mod:`shadelab.scene.model`. A typed value outside the spec is refused in place: the field
 shows the reason underneath and the scene keeps its value.
 """
@@ -111,18 +111,20 @@ def draw_pipeline_selector(state: AppState) -> bool:
     changed, index = imgui.combo("Pipeline", pipelines.PIPELINES.index(now), labels)
     if changed:
         pipelines.set_pipeline(state, pipelines.PIPELINES[index])
-    _, state.wipe = imgui.checkbox("Wipe: compare with", state.wipe)
-    if state.wipe:
+    _, state.view.wipe = imgui.checkbox("Wipe: compare with", state.view.wipe)
+    if state.view.wipe:
         imgui.same_line()
         imgui.set_next_item_width(180)
-        other = state.wipe_pipeline if state.wipe_pipeline in pipelines.PIPELINES else "raytrace"
+        other = state.view.wipe_pipeline
+        other = other if other in pipelines.PIPELINES else "raytrace"
         changed, j = imgui.combo("##wipe_with", pipelines.PIPELINES.index(other), labels)
         if changed:
-            state.wipe_pipeline = pipelines.PIPELINES[j]
-        _, state.wipe_position = imgui.slider_float("wipe position", state.wipe_position,
-                                                    0.0, 1.0, "%.2f")
-        if state.wipe_pipeline in pipelines.OFFLINE and now in pipelines.OFFLINE \
-                and state.wipe_pipeline != now:
+            state.view.wipe_pipeline = pipelines.PIPELINES[j]
+        _, state.view.wipe_position = imgui.slider_float("wipe position",
+                                                         state.view.wipe_position, 0.0, 1.0,
+                                                         "%.2f")
+        if state.view.wipe_pipeline in pipelines.OFFLINE and now in pipelines.OFFLINE \
+                and state.view.wipe_pipeline != now:
             imgui.text_colored(DIM_COLOR, "one offline pipeline at a time: the right side "
                                           "waits")
     return False   # the raster choice marks its own edit (set_pipeline)
@@ -147,16 +149,16 @@ def draw_algorithms_panel(state: AppState) -> bool:
         edited |= float_slider("ray offset", r, "offset", 1e-7, 0.1, log=True)
         edited |= float_slider("min weight", r, "min_weight", 0.0, 0.5)
     if imgui.collapsing_header("Path tracer", imgui.TreeNodeFlags_.default_open):
-        changed, spp = imgui.input_int("path spp", int(state.job_spp), 1, 16,
+        changed, spp = imgui.input_int("path spp", int(state.offline.spp), 1, 16,
                                        imgui.InputTextFlags_.enter_returns_true)
         _, lo, hi = field_spec(RaytraceSettings, "spp")
         if changed:
             if lo <= spp <= hi:
-                state.job_spp = int(spp)
+                state.offline.spp = int(spp)
                 _refused.pop("path_spp", None)
             else:
                 _refused["path_spp"] = f"path spp {spp} refused: expected {lo} to {hi} " \
-                                       f"(kept {state.job_spp})"
+                                       f"(kept {state.offline.spp})"
         _show_refusal("path_spp")
     if imgui.collapsing_header("Radiosity", imgui.TreeNodeFlags_.default_open):
         edited |= draw_radiosity_controls(state)
@@ -166,7 +168,7 @@ def draw_algorithms_panel(state: AppState) -> bool:
 
 def draw_pipeline_figures(state: AppState) -> None:
     """The running pipeline's figures: the radiosity residual curve, the picked ray tree."""
-    view = state.pipeline_view
+    view = state.view.pipeline_view
     if view is None:
         return
     name = pipelines.current(state)
@@ -291,8 +293,8 @@ def draw_radiosity_controls(state: AppState) -> bool:
     edited |= combo("solver", r, "solver", RADIOSITY_SOLVERS)
     edited |= int_field("iterations", r, "iterations")
     edited |= float_slider("tolerance", r, "tolerance", 1e-7, 0.1, log=True, fmt="%.2g")
-    _, state.radiosity_patches = imgui.checkbox("draw patches (radiosity pipeline)",
-                                                state.radiosity_patches)
+    _, state.view.radiosity_patches = imgui.checkbox("draw patches (radiosity pipeline)",
+                                                     state.view.radiosity_patches)
     return edited
 
 
