@@ -149,14 +149,15 @@ class Renderer:
         a light or changing a light's kind or attenuation mode compiles a new variant once.
         Passes that draw a subset of the lights (the shadow passes) switch the others off with
         their shadow factor S_i = 0. ``terminator``: the variant of the shadow-volume lit pass,
-        which fades S_i by the mesh's u_terminator (lighting.glsl's TERMINATOR); every other
-        pass has none to fade and leaves the term out.
+        which fades S_i by each point's threshold (lighting.glsl's TERMINATOR, switched by
+        u_terminator); every other pass has none to fade and leaves the term out, and so does
+        a replaced lighting chunk (a student's) without lighting.glsl's TERMINATOR blocks.
         """
         signature = self.light_signature_of(lights, specular)
         key = (signature, terminator)
         if key not in self._variants:
             defines = self.light_defines(signature)
-            if terminator:
+            if terminator and _chunk_fades(self.ctx):
                 defines["TERMINATOR"] = 1
             variant = {name: load_program(self.ctx, name, defines)
                        for name in TEXTURED_PROGRAMS.values()}
@@ -488,8 +489,9 @@ class Renderer:
 
     def draw_objects(self, scene: Scene, gpu_meshes: list[GpuMesh], shading: str,
                      terminator: bool = False) -> None:
-        """Draw each mesh with its material; ``terminator`` (the shadow-volume lit pass) sets
-        each smooth mesh's terminator threshold, which fades S_i where N.L nears it."""
+        """Draw each mesh with its material; ``terminator`` (the shadow-volume lit pass) turns
+        on the fade of S_i where N.L nears each point's terminator threshold (u_terminator 1)
+        on smooth meshes."""
         soften = terminator and shading != "flat"   # flat: N = Ng, nothing to join
         if not terminator:  # no per-mesh uniform: one draw per run of one material
             for run in _material_runs(gpu_meshes):
@@ -500,7 +502,7 @@ class Renderer:
             program_name = self.use_material(scene, gpu.mesh.material, shading)
             if terminator:
                 set_uniform(self.programs[program_name], "u_terminator",
-                            gpu.mesh.terminator if soften else 0.0)
+                            1.0 if soften and gpu.mesh.corner_terminators.any() else 0.0)
             self.vao(gpu, program_name).render(moderngl.TRIANGLES)
 
     def _batch(self, run: list[GpuMesh]) -> GpuMesh:
@@ -541,6 +543,13 @@ class Renderer:
             self._shadows.release()
             self._shadows = None
         self.textures.release()
+
+
+def _chunk_fades(ctx: moderngl.Context) -> bool:
+    """Whether the context's lighting chunk has the terminator fade (declares the
+    ``terminator_t`` that the programs' TERMINATOR code sets): ShadeLab's own does; a student's
+    copy with the TERMINATOR blocks deleted does not, and compiles without them."""
+    return "float terminator_t" in ctx.includes.get("lighting", "")
 
 
 def _material_runs(gpu_meshes: list[GpuMesh]) -> list[list[GpuMesh]]:
