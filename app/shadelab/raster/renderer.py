@@ -106,8 +106,11 @@ def make_view(scene: Scene, size: tuple[int, int], meshes: list[MeshData],
 class Renderer:
     """Draws a Scene with flat, Gouraud or Phong shading on any moderngl context."""
 
-    def __init__(self, ctx: moderngl.Context):
+    def __init__(self, ctx: moderngl.Context, exact: bool = False):
         self.ctx = ctx
+        # exact: the lecture's equation as written, no terminator fade in the shadow-volume
+        # lit pass (u_terminator = 0): what a course's reference images are rendered with
+        self.exact = exact
         self._variants: dict[tuple, dict[str, moderngl.Program]] = {}
         self._uniforms: dict[moderngl.Program, ProgramUniforms] = {}
         self._light_arrays: dict[str, tuple[str, dict[str, np.ndarray]]] = {}
@@ -491,8 +494,9 @@ class Renderer:
                      terminator: bool = False) -> None:
         """Draw each mesh with its material; ``terminator`` (the shadow-volume lit pass) turns
         on the fade of S_i where N.L nears each point's terminator threshold (u_terminator 1)
-        on smooth meshes."""
-        soften = terminator and shading != "flat"   # flat: N = Ng, nothing to join
+        on smooth meshes, unless the renderer is ``exact``."""
+        # flat: N = Ng, nothing to join
+        soften = terminator and shading != "flat" and not self.exact
         if not terminator:  # no per-mesh uniform: one draw per run of one material
             for run in _material_runs(gpu_meshes):
                 program_name = self.use_material(scene, run[0].mesh.material, shading)
