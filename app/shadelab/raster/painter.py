@@ -22,7 +22,7 @@ from shadelab.gl.vertex import VERTEX_FLOATS, soup_vertex_array, triangle_soup
 class SortedSoup:
     """Triangles of several objects in one buffer, farthest first, in runs of one object."""
 
-    soup: np.ndarray  # (3T, 14) float32
+    soup: np.ndarray  # (3T, VERTEX_FLOATS) float32
     runs: list[tuple[int, int, int]]  # (object position in the list given, first tri, count)
     depth: np.ndarray  # (T,) view depth of each triangle's centroid, sorted descending
 
