@@ -18,6 +18,7 @@ in vec3 g_normal[];
 in vec3 g_face_normal[];
 in vec3 g_centroid[];
 in vec2 g_uv[];
+in float g_terminator[];
 
 out vec3 v_a;
 out vec3 v_b;
@@ -30,6 +31,9 @@ void main() {
     for (int k = 0; k < 3; ++k) {
         vec3 p = g_position[k];
         vec3 n = normalize(g_normal[k]);
+#ifdef TERMINATOR
+        terminator_t = u_terminator * g_terminator[k];
+#endif
         if (dot(g_face_normal[k], u_eye - p) < 0.0) n = -n;  // back face: flip
         n = bump_normal(n, dpdu, dpdv, g_uv[k]);
         vec3 b = shade(p, n, u_eye, vec3(0.0));

@@ -6,11 +6,17 @@ uniform vec3 u_eye;
 in vec3 v_position;
 in vec3 v_normal;
 in vec2 v_uv;
+#ifdef TERMINATOR
+in float v_sine;
+#endif
 
 out vec4 f_color;
 
 void main() {
     vec3 n = normalize(v_normal);
+#ifdef TERMINATOR
+    terminator_t = u_terminator * v_sine / max(length(v_normal), 1e-12);
+#endif
     if (!gl_FrontFacing) n = -n;   // seen from behind: light the back
     f_color = vec4(shade(v_position, n, u_eye, u_Od), 1.0);
 }

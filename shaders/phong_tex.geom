@@ -12,11 +12,15 @@ uniform mat4 u_clip_from_world;
 
 in vec3 g_position[];
 in vec3 g_normal[];
+in float g_terminator[];
 in vec2 g_uv[];
 
 out vec3 v_position;
 out vec3 v_normal;
 out vec2 v_uv;
+#ifdef TERMINATOR
+out float v_sine;  // the corner's terminator threshold t_k
+#endif
 flat out vec3 v_dpdu;
 flat out vec3 v_dpdv;
 
@@ -29,6 +33,9 @@ void main() {
         v_position = g_position[k];
         v_normal = g_normal[k];
         v_uv = g_uv[k];
+#ifdef TERMINATOR
+        v_sine = g_terminator[k];
+#endif
         v_dpdu = dpdu;
         v_dpdv = dpdv;
         EmitVertex();

@@ -326,12 +326,14 @@ def likeliest_term(image: Any) -> tuple[str, float, float] | None:
         return None
     from shadelab.api import render
 
-    scene, size, shading, specular = source
+    scene, size, shading, specular, exact = (*source, False)[:5]
     specular = specular or scene.render.specular
     img = as_srgb8(image).astype(np.float64)
 
     def rmse(scene_, specular_) -> float:
-        ref = as_srgb8(render(scene_, size=size, shading=shading, specular=specular_))
+        ref = as_srgb8(_render_raster(scene_, {}, {}, size, shading, specular_, exact)
+                       if exact else render(scene_, size=size, shading=shading,
+                                            specular=specular_))
         return float(np.sqrt(np.mean((img - ref) ** 2)))
 
     full = rmse(scene, specular)
@@ -440,7 +442,8 @@ def _student_lines(log: str, texts: dict[str, str], names: dict[str, str]) -> st
 
 
 def render_with_shaders(scene: Any, includes: dict[str, str | Path], size: Any = (256, 256),
-                        shading: str | None = None, specular: str | None = None):
+                        shading: str | None = None, specular: str | None = None, *,
+                        exact: bool = True):
     """Render on the raster pipeline with GLSL includes replaced (a student's ``lighting``).
 
     Parameters
@@ -453,6 +456,11 @@ def render_with_shaders(scene: Any, includes: dict[str, str | Path], size: Any =
         include is kept.
     size, shading, specular
         As :func:`shadelab.render`.
+    exact : bool
+        Render the lecture's equation exactly as written (default): the shadow-volume pass
+        leaves out ShadeLab's terminator fade (a Renderer built with ``exact=True``:
+        u_terminator = 0), which a student's chunk does not have. False: ShadeLab's own
+        frame, fade included, as :func:`shadelab.render` draws it.
 
     Returns
     -------
@@ -464,18 +472,36 @@ def render_with_shaders(scene: Any, includes: dict[str, str | Path], size: Any =
     AssertionError
         When the replaced shaders do not compile or link (the GLSL log is in the message).
     """
-    import moderngl
-
-    from shadelab.api import Image, _scene, _size
-    from shadelab.gl.context import headless_context
-    from shadelab.gl.target import RenderTarget
-    from shadelab.raster.renderer import Renderer
+    from shadelab.api import _scene, _size
 
     scene = _scene(scene)
     wh = _size(size, "raster")
     texts, names = _include_texts(includes)
+    return _render_raster(scene, texts, names, wh, shading, specular, exact)
+
+
+def reference_image(scene: Any, size: Any = (256, 256), shading: str | None = None,
+                    specular: str | None = None, *, exact: bool = True):
+    """ShadeLab's own shaders rendered as :func:`render_with_shaders` renders a student's
+    (``exact`` by default): the image a course's references are made from."""
+    from shadelab.api import _scene, _size
+
+    return _render_raster(_scene(scene), {}, {}, _size(size, "raster"), shading, specular,
+                          exact)
+
+
+def _render_raster(scene, texts: dict[str, str], names: dict[str, str], wh, shading, specular,
+                   exact: bool):
+    import moderngl
+
+    from shadelab.api import Image
+    from shadelab.gl.context import headless_context
+    from shadelab.gl.target import RenderTarget
+    from shadelab.raster.renderer import Renderer
+
     ctx = headless_context()
-    renderer = Renderer(ctx)  # its own program cache: the shared renderer stays untouched
+    # its own program cache: the shared renderer stays untouched
+    renderer = Renderer(ctx, exact=exact)
     target = RenderTarget(ctx, wh)
     try:
         with _includes_replaced(texts):
@@ -491,7 +517,7 @@ def render_with_shaders(scene: Any, includes: dict[str, str | Path], size: Any =
     image = Image(array, scene.render.exposure,
                   {"pipeline": "raster", "shading": shading or scene.render.shading,
                    "includes": sorted(texts)})
-    image._source = (scene, wh, shading, specular)  # what likeliest_term re-renders
+    image._source = (scene, wh, shading, specular, exact)  # what likeliest_term re-renders
     return image
 
 
@@ -502,10 +528,21 @@ class ImageChecker:
     """What the ``shadelab_images`` fixture gives a test (references beside the test file)."""
 
     def __init__(self, test_dir: Path, regenerate: bool, golden: str = "golden",
-                 output: str = "_output"):
+                 output: str = "_output", exact: bool = True):
         self.golden_dir = test_dir / golden
         self.output_dir = test_dir / output
         self.regenerate = regenerate
+        self.exact = exact  # render() draws the lecture's exact equation (no terminator fade)
+
+    def render(self, scene: Any, includes: dict[str, str | Path] | None = None,
+               size: Any = (256, 256), shading: str | None = None,
+               specular: str | None = None):
+        """:func:`render_with_shaders` (``includes``) or ShadeLab's own shaders (None), with
+        this checker's ``exact`` (ini ``shadelab_exact``, default true)."""
+        if includes:
+            return render_with_shaders(scene, includes, size, shading, specular,
+                                       exact=self.exact)
+        return reference_image(scene, size, shading, specular, exact=self.exact)
 
     def check(self, name: str, image: Any, threshold: str | Threshold = "golden",
               exposure: float | None = None) -> dict:
@@ -523,6 +560,9 @@ def pytest_addoption(parser) -> None:
                   default="golden")
     parser.addini("shadelab_output_dir", "folder for failure images, beside each test file",
                   default="_output")
+    parser.addini("shadelab_exact", "shadelab_images.render draws the lecture's exact "
+                  "equation (no terminator fade under shadow volumes)", type="bool",
+                  default=True)
 
 
 def _regenerate(config) -> bool:
@@ -541,4 +581,5 @@ if _pytest is not None:
         """Compare images with references beside the test file (``golden/<name>.png``)."""
         return ImageChecker(Path(str(request.node.path)).parent, _regenerate(request.config),
                             request.config.getini("shadelab_golden_dir"),
-                            request.config.getini("shadelab_output_dir"))
+                            request.config.getini("shadelab_output_dir"),
+                            request.config.getini("shadelab_exact"))

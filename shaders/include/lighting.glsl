@@ -53,8 +53,8 @@ uniform int u_light_attenuation[MAX_LIGHTS];     // ATTENUATION_NONE | _INVERSE_
 uniform vec3 u_light_c[MAX_LIGHTS];              // c1, c2, c3 of the lecture's f_att
 uniform vec2 u_light_spot[MAX_LIGHTS];           // cos(cone half-angle), falloff exponent
 uniform float u_light_S[MAX_LIGHTS];             // shadow factor S_i: 1 lit, 0 blocked
-uniform float u_terminator;                      // the mesh's terminator threshold t (shadow
-                                                 // volume pass only; 0: off)
+uniform float u_terminator;                      // shadow-volume lit pass: 1 fades S_i by the
+                                                 // point's threshold t; 0: off (exact equation)
 
 uniform vec3 u_Ia;                               // ambient intensity
 uniform float u_ambient_on;                      // 1: add Le + Ia ka Od (first pass only)
@@ -101,6 +101,14 @@ float blinn_phong_specular(vec3 n, vec3 to_light, vec3 to_eye, float shininess) 
     return dot(n, to_light) > 0.0 ? lobe : 0.0;
 }
 
+#ifdef TERMINATOR
+// The threshold t at the point being shaded, set by the program's main before shade():
+// u_terminator * sum_k b_k t_k / |sum_k b_k N_k| (Phong), u_terminator * t_k (Gouraud), with
+// t_k the corner's vertex attribute in_terminator (geometry/normals.py vertex_terminators,
+// threshold_at). 0: no fade.
+float terminator_t = 0.0;
+#endif
+
 // The self-shadow part of S_i on a smooth mesh: smoothstep(t, 2t, N.L); 1 for t = 0.
 // The faces turned from the light sit in their own shadow volume while their shading normals
 // reach N.L <= t; fading to 0 there joins the two with no step (terminator_softening in
@@ -140,8 +148,8 @@ vec3 shade_light(int i, vec3 position, vec3 n, vec3 to_eye, vec3 od) {
     float specular;
     if (SPECULAR_MODEL == SPECULAR_BLINN) specular = blinn_phong_specular(n, to_light, to_eye, u_n);
     else specular = phong_specular(n, to_light, to_eye, u_n);
-#ifdef TERMINATOR  // the shadow-volume lit pass; elsewhere u_terminator is 0: no term
-    float s = LIGHT_S(i) * terminator_softening(dot(n, to_light), u_terminator);
+#ifdef TERMINATOR  // the shadow-volume lit pass; elsewhere no term
+    float s = LIGHT_S(i) * terminator_softening(dot(n, to_light), terminator_t);
 #else
     float s = LIGHT_S(i);
 #endif

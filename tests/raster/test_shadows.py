@@ -72,10 +72,11 @@ def oracle_masks(scene) -> tuple[np.ndarray, np.ndarray]:
     return np.array(shadowed), np.array(matters)
 
 
-def pixel_surfaces(scene, index: int):
+def pixel_surfaces(scene, index: int, thresholds: bool = False):
     """Object ``index`` as the camera sees it, per pixel centre (Embree primary rays): the
     flat pixel numbers, world positions, interpolated (Phong) normals and face normals of the
-    hits on the side the camera sees."""
+    hits on the side the camera sees (``thresholds``: and each hit's terminator threshold,
+    :func:`shadelab.geometry.normals.threshold_at`)."""
     from trimesh.triangles import points_to_barycentric
 
     meshes = scene_meshes(scene)
@@ -94,7 +95,13 @@ def pixel_surfaces(scene, index: int):
     normal = np.einsum("rc,rck->rk", bary, mesh.corner_normals[tri])
     normal /= np.linalg.norm(normal, axis=1, keepdims=True)
     front = np.einsum("rk,rk->r", normal, dirs[ray]) < 0.0
-    return ray[front], loc[front], normal[front], mesh.face_normals[tri[front]]
+    out = ray[front], loc[front], normal[front], mesh.face_normals[tri[front]]
+    if thresholds:
+        from shadelab.geometry.normals import threshold_at
+
+        tri, bary = tri[front], bary[front]
+        out += (threshold_at(mesh.corner_terminators[tri], mesh.corner_normals[tri], bary),)
+    return out
 
 
 def gl_masks(scene) -> np.ndarray:
@@ -206,10 +213,9 @@ def test_shadowed_frame_is_ambient_where_masked_and_unchanged_elsewhere(gl_ctx):
     assert np.abs(shadowed[mask] - ambient[mask]).max() < 1e-5
     # the smooth sphere's terminator band (N.L < 2t) fades S_i (tests/raster/test_terminator.py):
     # there the light's term is scaled by the fade, everywhere else it is left as it was
-    ray, position, normal, _ = pixel_surfaces(scene, 1)
+    ray, position, normal, _, t = pixel_surfaces(scene, 1, thresholds=True)
     to_light = np.asarray(scene.lights[0].position, float) - position
     to_light /= np.linalg.norm(to_light, axis=1, keepdims=True)
-    t = scene_meshes(scene)[1].terminator
     band = np.zeros(mask.size, bool)
     band[ray[np.einsum("rk,rk->r", normal, to_light) < 2.0 * t]] = True
     band = band.reshape(mask.shape)

@@ -72,9 +72,10 @@ def test_flat_meshes_have_no_threshold():
 
 
 def _torus_pixels(scene):
-    """Per pixel on the torus: pixel number, position, Phong normal, t, face normal."""
-    ray, position, normal, ng = pixel_surfaces(scene, 1)
-    return ray, position, normal, scene_meshes(scene)[1].terminator, ng
+    """Per pixel on the torus: pixel number, position, Phong normal, the point's t, face
+    normal."""
+    ray, position, normal, ng, t = pixel_surfaces(scene, 1, thresholds=True)
+    return ray, position, normal, t, ng
 
 
 def test_smooth_closed_mesh_lit_side_matches_the_shadow_ray_oracle(gl_ctx):

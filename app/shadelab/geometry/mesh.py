@@ -21,7 +21,14 @@ from pyrr import matrix33
 from shadelab import limits
 from shadelab.errors import ShadeLabError
 from shadelab.geometry import cache
-from shadelab.geometry.normals import corner_normals, face_areas, face_normals, terminator_threshold
+from shadelab.geometry.normals import (
+    corner_normals,
+    face_areas,
+    face_normals,
+    flipped_corners,
+    terminator_threshold,
+    vertex_terminators,
+)
 from shadelab.paths import file_problem
 from shadelab.progress import busy, steps
 from shadelab.scene.model import LENGTH_MAX, Object, Scene
@@ -63,6 +70,18 @@ class MeshData:
     def terminator(self) -> float:
         """sin of the widest face-to-corner normal angle (see :func:`terminator_threshold`)."""
         return terminator_threshold(self.face_normals, self.corner_normals)
+
+    @cached_property
+    def corner_terminators(self) -> np.ndarray:
+        """(F, 3) the terminator threshold t_v at each corner (:func:`vertex_terminators`),
+        the ``in_terminator`` vertex attribute of the shadow-volume lit pass; notes once
+        when some corner normals lean more than 90 degrees from their face (left out)."""
+        flipped = flipped_corners(self.face_normals, self.corner_normals)
+        if flipped:
+            note(f"objects.{self.index}: {flipped} corner normal(s) lean more than 90 degrees "
+                 f"from their face; the shadow terminator fade leaves them out")
+        return vertex_terminators(self.vertices, self.faces, self.face_normals,
+                                  self.corner_normals)
 
 
 def geometry_key(obj: Object, base_dir: str) -> tuple:

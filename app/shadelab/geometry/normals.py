@@ -132,20 +132,72 @@ def corner_normals(vertices: np.ndarray, faces: np.ndarray, mode: str,
     return out
 
 
+def corner_sines(fn: np.ndarray, cn: np.ndarray) -> np.ndarray:
+    """(F, 3) sin of the angle between each corner normal and its face's normal: the
+    bound at that corner for that face alone (:func:`vertex_terminators` shares it).
+
+    A shading normal interpolated over a face from its corners has Ns.L <= sum_k b_k s_k /
+    |sum_k b_k N_k| on a face turned from the light (Ng.L <= 0), since N_k.L <= s_k there
+    (:func:`threshold_at`). A corner normal more than 90 degrees from its face (a fold or a
+    sliver on a real mesh) bounds nothing below 1; it is left out of the fade (s = 0)
+    rather than darken its faces' lit side (:func:`flipped_corners` counts them).
+    """
+    sine = np.linalg.norm(np.cross(cn, fn[:, None, :]), axis=-1)
+    return np.where(np.einsum("fk,fck->fc", fn, cn) > 0.0, sine, 0.0)
+
+
+def vertex_terminators(vertices: np.ndarray, faces: np.ndarray, fn: np.ndarray,
+                       cn: np.ndarray) -> np.ndarray:
+    """(F, 3) the terminator threshold t_v at each corner: the largest :func:`corner_sines`
+    over the corners that share its position and its normal (the faces the shading normal is
+    continuous over). Both faces of a silhouette edge then interpolate the same t along it,
+    so the fade is 0 there on the lit face as on the face in its own shadow volume: no step.
+    """
+    sines = corner_sines(fn, cn)
+    if len(faces) == 0:
+        return sines
+    keys = np.concatenate([vertices[faces].reshape(-1, 3), cn.reshape(-1, 3)], axis=1)
+    _, group = np.unique(keys, axis=0, return_inverse=True)
+    group = group.reshape(-1)
+    most = np.zeros(group.max() + 1)
+    np.maximum.at(most, group, sines.reshape(-1))
+    return most[group].reshape(faces.shape)
+
+
+def flipped_corners(fn: np.ndarray, cn: np.ndarray) -> int:
+    """How many corner normals lean more than 90 degrees from their face (degenerate faces,
+    whose normal is zero, not counted)."""
+    if len(fn) == 0:
+        return 0
+    real = np.linalg.norm(fn, axis=-1) > 0.5
+    return int(np.count_nonzero((np.einsum("fk,fck->fc", fn, cn) <= 0.0) & real[:, None]))
+
+
+def threshold_at(sines: np.ndarray, cn: np.ndarray, bary: np.ndarray) -> np.ndarray:
+    """The terminator threshold (...) at points inside faces: sum_k b_k s_k / |sum_k b_k N_k|.
+
+    ``sines`` (..., 3) and ``cn`` (..., 3, 3) of each point's face, ``bary`` (..., 3). The
+    Phong fragment shader interpolates s_k and N_k the same way (phong.vert / phong.frag);
+    Gouraud shades at the corners, where it is s_k.
+    """
+    m = np.einsum("...c,...ck->...k", bary, cn)
+    return np.einsum("...c,...c->...", bary, sines) / np.maximum(np.linalg.norm(m, axis=-1),
+                                                                   1e-12)
+
+
 def terminator_threshold(fn: np.ndarray, cn: np.ndarray) -> float:
-    """sin(delta): delta is the widest angle between a face's normal and its corner normals.
+    """sin(delta): delta is the widest angle between a face's normal and its corner normals
+    (corner normals more than 90 degrees from their face left out, as in
+    :func:`corner_sines`): the largest of the mesh's corner thresholds.
 
     A shading normal interpolated over a face stays within delta of the face normal, so on a
     face turned from the light (Ng.L <= 0) it has Ns.L <= sin(delta). Stencil shadow volumes
     put exactly those faces in shadow; the shadow pass fades the light over
-    sin(delta) <= Ns.L <= 2 sin(delta) (:func:`shadelab.shading.reference.terminator_softening`)
-    so the lit side meets the faces in the volume with no step. 0 for flat-shaded meshes.
+    t <= Ns.L <= 2 t (:func:`shadelab.shading.reference.terminator_softening`) with t the
+    point's own threshold (:func:`threshold_at`), at most about this, so the lit side meets
+    the faces in the volume with no step. 0 for flat-shaded meshes.
     """
     if len(fn) == 0:
         return 0.0
-    cosine = np.einsum("fk,fck->fc", fn, cn)
-    worst = float(cosine.min())
-    if worst <= 0.0:  # a corner normal turned past 90 degrees from its face: fade fully
-        return 1.0
-    sine = float(np.sqrt(max(0.0, 1.0 - worst * worst)))
+    sine = float(corner_sines(fn, cn).max())
     return sine if sine > 1e-6 else 0.0   # flat faces up to rounding (a rotated box: 1e-8)

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from shadelab.geometry.mesh import MeshData, scene_meshes
+from shadelab.geometry.normals import threshold_at
 from shadelab.raytrace.accel import build_accel, scene_geometry
 from shadelab.scene.camera import primary_rays
 from shadelab.scene.model import Scene
@@ -158,7 +159,9 @@ def probe(scene: Scene, size: tuple[int, int], pixel: tuple[int, int], shading: 
     if scene.render.shadows == "volumes" and material.kt <= 0.0 and lights:
         # the stencil's S_i at this pixel; transparent surfaces are drawn unshadowed
         shadow = probe_shadows(scene, hit.point, _facing(fn, fn, to_eye), lights)
-        fade = mesh.terminator if shading != "flat" else 0.0
+        if shading != "flat":  # the point's own threshold (geometry/normals.threshold_at)
+            fade = threshold_at(mesh.corner_terminators[face], mesh.corner_normals[face],
+                                np.asarray(hit.bary, dtype=np.float64))
     terms = shade_terms(hit.point, normal, eye, material, lights, scene.Ia, specular, shadow,
                         terminator=fade)
     if shading == "flat":
@@ -169,8 +172,9 @@ def probe(scene: Scene, size: tuple[int, int], pixel: tuple[int, int], shading: 
     elif shading == "gouraud":
         n_v = _facing(mesh.corner_normals[face], np.broadcast_to(fn, (3, 3)), eye - corners)
         at_corners = None if shadow is None else [np.broadcast_to(s, (3, 3)) for s in shadow]
+        at_t = 0.0 if shadow is None else mesh.corner_terminators[face]  # the corners' t_v
         colors = shade_terms(corners, n_v, eye, material, lights, scene.Ia, specular,
-                             at_corners, terminator=fade).total
+                             at_corners, terminator=at_t).total
         reference = hit.bary @ colors
     else:
         reference = terms.total

@@ -15,14 +15,14 @@ import moderngl
 import numpy as np
 
 from shadelab.gl.blend import restore_blend, set_blend
-from shadelab.gl.vertex import soup_vertex_array, triangle_soup
+from shadelab.gl.vertex import VERTEX_FLOATS, soup_vertex_array, triangle_soup
 
 
 @dataclass
 class SortedSoup:
     """Triangles of several objects in one buffer, farthest first, in runs of one object."""
 
-    soup: np.ndarray  # (3T, 14) float32
+    soup: np.ndarray  # (3T, VERTEX_FLOATS) float32
     runs: list[tuple[int, int, int]]  # (object position in the list given, first tri, count)
     depth: np.ndarray  # (T,) view depth of each triangle's centroid, sorted descending
 
@@ -38,15 +38,15 @@ def sort_back_to_front(scene, meshes) -> SortedSoup:
     forward = view_forward(scene)
     soups, depths, owners = [], [], []
     for position, mesh in enumerate(meshes):
-        soups.append(triangle_soup(mesh).reshape(-1, 3, 14))
+        soups.append(triangle_soup(mesh).reshape(-1, 3, VERTEX_FLOATS))
         depths.append((mesh.triangles.mean(axis=1) - eye) @ forward)
         owners.append(np.full(len(mesh.faces), position))
     if not soups:
-        return SortedSoup(np.zeros((0, 14), np.float32), [], np.zeros(0))
+        return SortedSoup(np.zeros((0, VERTEX_FLOATS), np.float32), [], np.zeros(0))
     depth = np.concatenate(depths)
     order = np.argsort(-depth, kind="stable")
     owner = np.concatenate(owners)[order]
-    soup = np.concatenate(soups)[order].reshape(-1, 14)
+    soup = np.concatenate(soups)[order].reshape(-1, VERTEX_FLOATS)
     starts = np.flatnonzero(np.diff(owner, prepend=-1))
     ends = np.append(starts[1:], len(owner))
     runs = [(int(owner[s]), int(s), int(e - s)) for s, e in zip(starts, ends, strict=True)]

@@ -106,8 +106,11 @@ def make_view(scene: Scene, size: tuple[int, int], meshes: list[MeshData],
 class Renderer:
     """Draws a Scene with flat, Gouraud or Phong shading on any moderngl context."""
 
-    def __init__(self, ctx: moderngl.Context):
+    def __init__(self, ctx: moderngl.Context, exact: bool = False):
         self.ctx = ctx
+        # exact: the lecture's equation as written, no terminator fade in the shadow-volume
+        # lit pass (u_terminator = 0): what a course's reference images are rendered with
+        self.exact = exact
         self._variants: dict[tuple, dict[str, moderngl.Program]] = {}
         self._uniforms: dict[moderngl.Program, ProgramUniforms] = {}
         self._light_arrays: dict[str, tuple[str, dict[str, np.ndarray]]] = {}
@@ -149,14 +152,15 @@ class Renderer:
         a light or changing a light's kind or attenuation mode compiles a new variant once.
         Passes that draw a subset of the lights (the shadow passes) switch the others off with
         their shadow factor S_i = 0. ``terminator``: the variant of the shadow-volume lit pass,
-        which fades S_i by the mesh's u_terminator (lighting.glsl's TERMINATOR); every other
-        pass has none to fade and leaves the term out.
+        which fades S_i by each point's threshold (lighting.glsl's TERMINATOR, switched by
+        u_terminator); every other pass has none to fade and leaves the term out, and so does
+        a replaced lighting chunk (a student's) without lighting.glsl's TERMINATOR blocks.
         """
         signature = self.light_signature_of(lights, specular)
         key = (signature, terminator)
         if key not in self._variants:
             defines = self.light_defines(signature)
-            if terminator:
+            if terminator and _chunk_fades(self.ctx):
                 defines["TERMINATOR"] = 1
             variant = {name: load_program(self.ctx, name, defines)
                        for name in TEXTURED_PROGRAMS.values()}
@@ -489,9 +493,11 @@ class Renderer:
 
     def draw_objects(self, scene: Scene, gpu_meshes: list[GpuMesh], shading: str,
                      terminator: bool = False) -> None:
-        """Draw each mesh with its material; ``terminator`` (the shadow-volume lit pass) sets
-        each smooth mesh's terminator threshold, which fades S_i where N.L nears it."""
-        soften = terminator and shading != "flat"   # flat: N = Ng, nothing to join
+        """Draw each mesh with its material; ``terminator`` (the shadow-volume lit pass) turns
+        on the fade of S_i where N.L nears each point's terminator threshold (u_terminator 1)
+        on smooth meshes, unless the renderer is ``exact``."""
+        # flat: N = Ng, nothing to join
+        soften = terminator and shading != "flat" and not self.exact
         if not terminator:  # no per-mesh uniform: one draw per run of one material
             for run in _material_runs(gpu_meshes):
                 program_name = self.use_material(scene, run[0].mesh.material, shading)
@@ -501,7 +507,7 @@ class Renderer:
             program_name = self.use_material(scene, gpu.mesh.material, shading)
             if terminator:
                 set_uniform(self.programs[program_name], "u_terminator",
-                            gpu.mesh.terminator if soften else 0.0)
+                            1.0 if soften and gpu.mesh.corner_terminators.any() else 0.0)
             self.vao(gpu, program_name).render(moderngl.TRIANGLES)
 
     def _batch(self, run: list[GpuMesh]) -> GpuMesh:
@@ -542,6 +548,13 @@ class Renderer:
             self._shadows.release()
             self._shadows = None
         self.textures.release()
+
+
+def _chunk_fades(ctx: moderngl.Context) -> bool:
+    """Whether the context's lighting chunk has the terminator fade (declares the
+    ``terminator_t`` that the programs' TERMINATOR code sets): ShadeLab's own does; a student's
+    copy with the TERMINATOR blocks deleted does not, and compiles without them."""
+    return "float terminator_t" in ctx.includes.get("lighting", "")
 
 
 def _material_runs(gpu_meshes: list[GpuMesh]) -> list[list[GpuMesh]]:

@@ -23,6 +23,21 @@ HEAT_STOPS = ((0.0, 0.0, 0.0), (0.0, 0.0, 1.0), (0.0, 1.0, 0.0), (1.0, 1.0, 0.0)
 HEAT_EPS = 1e-12  # guard of the heat map's full-scale difference
 
 
+def linear_to_srgb(linear) -> np.ndarray:
+    """The sRGB encoding of linear values (negatives to 0; above 1 the power law goes on, so
+    :func:`srgb_to_linear` undoes it)."""
+    c = np.maximum(np.asarray(linear, dtype=np.float64), 0.0)
+    return np.where(c <= SRGB_LINEAR_MAX, SRGB_SLOPE * c,
+                    SRGB_SCALE * np.power(c, 1.0 / SRGB_GAMMA) - SRGB_OFFSET)
+
+
+def srgb_to_linear(srgb) -> np.ndarray:
+    """The linear values of sRGB-encoded ones (the inverse of :func:`linear_to_srgb`)."""
+    s = np.maximum(np.asarray(srgb, dtype=np.float64), 0.0)
+    return np.where(s <= SRGB_SLOPE * SRGB_LINEAR_MAX, s / SRGB_SLOPE,
+                    np.power((s + SRGB_OFFSET) / SRGB_SCALE, SRGB_GAMMA))
+
+
 def to_srgb8(linear: np.ndarray, exposure: float = 1.0) -> np.ndarray:
     """Linear RGB (H, W, 3) -> sRGB uint8, clipped to [0, 1] after exposure."""
     c = np.clip(np.nan_to_num(linear * exposure, nan=0.0, posinf=1.0), 0.0, 1.0)

@@ -135,25 +135,26 @@ def shadow_filter(material: Material) -> np.ndarray:
     return material.kt * np.asarray(tint, dtype=np.float64)
 
 
-def terminator_softening(n_dot_l: np.ndarray, threshold: float) -> np.ndarray:
-    """The self-shadow part of S_i on a smooth mesh: smoothstep(t, 2t, N.L), t = ``threshold``.
+def terminator_softening(n_dot_l: np.ndarray, threshold) -> np.ndarray:
+    """The self-shadow part of S_i on a smooth mesh: smoothstep(t, 2t, N.L), t = ``threshold``
+    (a number, or one per point: :func:`shadelab.geometry.normals.threshold_at`).
 
     Shadow volumes follow the faces: a face turned from the light is inside its own volume
-    (S_i = 0) while its interpolated normal can still see the light, up to N.L = t = sin(delta)
-    (:func:`shadelab.geometry.normals.terminator_threshold`). Fading the light to 0 at N.L = t
+    (S_i = 0) while its interpolated normal can still see the light, up to N.L = t
+    (:func:`shadelab.geometry.normals.corner_sines`). Fading the light to 0 at N.L = t
     joins the lit side to those faces with no step; t = 0 (flat meshes) leaves S_i = 1.
     """
     n_dot_l = np.asarray(n_dot_l, dtype=np.float64)
-    if threshold <= 0.0:
-        return np.ones(n_dot_l.shape)
-    x = np.clip((n_dot_l - threshold) / threshold, 0.0, 1.0)
-    return x * x * (3.0 - 2.0 * x)
+    t = np.broadcast_to(np.asarray(threshold, dtype=np.float64), n_dot_l.shape)
+    on = t > 0.0
+    x = np.clip((n_dot_l - t) / np.where(on, t, 1.0), 0.0, 1.0)
+    return np.where(on, x * x * (3.0 - 2.0 * x), 1.0)
 
 
 def shade_terms(position: np.ndarray, normal: np.ndarray, eye: np.ndarray, material: Material,
                 lights: list[Light], Ia, specular: str = "phong",
                 shadow: list[np.ndarray] | None = None,
-                od: np.ndarray | None = None, terminator: float = 0.0) -> ShadeTerms:
+                od: np.ndarray | None = None, terminator=0.0) -> ShadeTerms:
     """Every term of the lecture's equation at each point.
 
     Parameters
@@ -168,8 +169,8 @@ def shade_terms(position: np.ndarray, normal: np.ndarray, eye: np.ndarray, mater
     shadow : one S_i array (...) per light, 1 = lit, or (..., 3) per channel (the kt-filtered
         S_i of transparent casters); default all lit
     od : (..., 3) optional per-point diffuse color (textures), replacing material.Od
-    terminator : the mesh's terminator threshold t (shadow volumes on); S_i is multiplied by
-        :func:`terminator_softening` (N.L_i, t). 0 (the default): no softening
+    terminator : the terminator threshold t (shadow volumes on), a number or (...) per point;
+        S_i is multiplied by :func:`terminator_softening` (N.L_i, t). 0 (the default): none
 
     Notes
     -----
@@ -195,7 +196,7 @@ def shade_terms(position: np.ndarray, normal: np.ndarray, eye: np.ndarray, mater
         rgb = s.shape == shape + (3,) and shadow is not None   # kt-filtered S_i per channel
         if not rgb:
             s = np.broadcast_to(s, shape)
-        if terminator > 0.0:
+        if np.any(np.asarray(terminator) > 0.0):
             soft = terminator_softening(np.sum(n * to_light, axis=-1), terminator)
             s = s * (soft[..., None] if rgb else soft)
         s3 = s if rgb else s[..., None]
@@ -211,7 +212,7 @@ def shade_terms(position: np.ndarray, normal: np.ndarray, eye: np.ndarray, mater
 def shade(position: np.ndarray, normal: np.ndarray, eye: np.ndarray, material: Material,
           lights: list[Light], Ia, specular: str = "phong",
           shadow: list[np.ndarray] | None = None, od: np.ndarray | None = None,
-          terminator: float = 0.0) -> np.ndarray:
+          terminator=0.0) -> np.ndarray:
     """The lecture's illumination I (..., 3) at each point; see :func:`shade_terms`.
 
     Notes

@@ -13,6 +13,7 @@ import numpy as np
 from imgui_bundle import imgui
 
 from shadelab.lab.state import AppState
+from shadelab.shading.conventions import linear_to_srgb, srgb_to_linear
 from shadelab.ui.ranges import intensity_range
 
 ERROR_COLOR = imgui.ImVec4(1.0, 0.35, 0.3, 1.0)
@@ -31,9 +32,25 @@ def combo(label: str, value: str, choices: tuple[str, ...]) -> tuple[bool, str]:
     return changed, choices[index]
 
 
+def shown_color(value) -> tuple[float, float, float]:
+    """What a colour picker shows for a linear RGB value: the colour as it appears on screen
+    (sRGB-encoded, as the frame is)."""
+    return tuple(float(c) for c in linear_to_srgb(value))
+
+
+def stored_color(shown) -> tuple[float, float, float]:
+    """The linear RGB a picker's edited (on-screen, sRGB) colour stands for."""
+    return tuple(float(c) for c in srgb_to_linear(shown))
+
+
 def rgb_color(label: str, value) -> tuple[bool, tuple[float, float, float]]:
-    changed, rgb = imgui.color_edit3(label, list(value), imgui.ColorEditFlags_.float)
-    return changed, tuple(float(c) for c in rgb)
+    """A colour picker on a linear RGB value (presets and the equation are linear): it shows
+    and edits the colour as it appears on screen; an untouched value is returned as it was."""
+    changed, rgb = imgui.color_edit3(label, list(shown_color(value)),
+                                     imgui.ColorEditFlags_.float)
+    if not changed:
+        return False, tuple(float(c) for c in value)
+    return True, stored_color(rgb)
 
 
 def intensity_color(label: str, value) -> tuple[bool, tuple[float, float, float]]:
