@@ -140,7 +140,7 @@ def pipeline_radiosity(scene: Scene, size: tuple[int, int] | None = None,
     from shadelab.radiosity import display
     from shadelab.radiosity.formfactors import FormFactors
     from shadelab.radiosity.patches import check_count, uniform_patches
-    from shadelab.radiosity.solution import check_scene
+    from shadelab.radiosity.solution import check_scene, scene_accel, sources
     from shadelab.radiosity.solvers import check_solvable, run_solver
 
     settings = scene.radiosity
@@ -159,10 +159,11 @@ def pipeline_radiosity(scene: Scene, size: tuple[int, int] | None = None,
         _RADIOSITY_CACHE[key] = cached
     patches, ff, token = cached
     rho, emission = _reflectance(scene, patches)
-    E = math.pi * emission
+    light: dict = {}
+    E = sources(scene, patches, scene_accel(scene), light, rho=rho, emission=emission)
     n = len(patches)
     base = {"patches": n, "form_factors": ff.method, "solver": settings.solver,
-            "form_factors_reused": reused, "ff_token": token, "unit": "patches"}
+            "form_factors_reused": reused, "ff_token": token, "unit": "patches", **light}
     shooter = [-1]
 
     def row(i: int) -> np.ndarray:
@@ -216,6 +217,6 @@ def _radiosity_progress(patches, rho, step, shooter, history, base, start, displ
         stats["shooter"] = np.asarray(patches.polygons[shooter], np.float32)
         stats["shooter_index"] = int(shooter)
     return Progress(None, max(fraction, 0.0), ("done: " if final else "") + what
-                    + f" ({len(patches)} patches)", stats)
+                    + f" ({len(patches)} patches; {base['light']})", stats)
 
 

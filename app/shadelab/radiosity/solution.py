@@ -95,11 +95,45 @@ class RadiositySolution:
 
 # ---------------------------------------------------------------------- checks
 def check_scene(scene: Scene) -> None:
-    """Refuse a scene radiosity cannot light: nothing emits."""
+    """Refuse a scene radiosity cannot light: nothing emits and no point, spot or directional
+    light (other than a ``stand_in``) is on."""
+    from shadelab.radiosity.direct import direct_lights
+
     used = {obj.material for obj in scene.objects}
+    if direct_lights(scene):
+        return
     if not any(max(scene.materials[m].emission) > 0.0 for m in used if m in scene.materials):
         raise ShadeLabError(f"{scene.name or 'scene'}: no object has a material with emission "
-                            f"> 0, so radiosity has no light to spread (set materials.X.emission)")
+                            f"> 0 and no light is on, so radiosity has no light to spread (set "
+                            f"materials.X.emission or add a light)")
+
+
+def sources(scene: Scene, patches: PatchSet, accel=None, stats: dict | None = None,
+            rho: np.ndarray | None = None, emission: np.ndarray | None = None) -> np.ndarray:
+    """(N, 3) the right-hand side E of B = E + rho F B: the emitters' pi * Le plus the
+    lights' direct light reflected, rho * H (the first shot, :mod:`.direct`). ``stats``
+    gets ``light_power`` (per light), ``emitted_power`` and the one-line ``light``.
+    ``rho``, ``emission`` (N, 3): the current materials' (default: the patches' own)."""
+    from shadelab.radiosity.direct import describe, direct_radiosity
+
+    E_direct, power = direct_radiosity(scene, patches, accel=accel, rho=rho)
+    E_emit = patches.E if emission is None else math.pi * np.asarray(emission, float)
+    E = E_emit + E_direct
+    if stats is not None:
+        emitted = float((patches.areas[:, None] * E_emit).sum() / 3.0)
+        stats.update(light_power=power, emitted_power=emitted, light=describe(power, emitted))
+    return E
+
+
+def scene_accel(scene: Scene):
+    """The shadow-ray accelerator of the direct light (None when no light needs one)."""
+    from shadelab.radiosity.direct import direct_lights
+
+    if not direct_lights(scene):
+        return None
+    from shadelab.raytrace.accel import build_accel, scene_geometry
+
+    return build_accel(scene_geometry(scene))
 
 
 def precheck(scene: Scene, count: int, method: str = "raycast") -> None:
@@ -154,6 +188,7 @@ def mesh_scene(scene: Scene, count: int, method: str = "raycast", adaptive: bool
     if not adaptive or count < 8:
         return uniform_patches(scene, count)
     patches = uniform_patches(scene, max(1, int(count * REFINE_SHARE)))
+    accel = scene_accel(scene)
     for round_ in range(REFINE_ROUNDS):
         budget = count if round_ == REFINE_ROUNDS - 1 else \
             len(patches) + (count - len(patches)) // 2
@@ -162,7 +197,7 @@ def mesh_scene(scene: Scene, count: int, method: str = "raycast", adaptive: bool
             break
         F = FormFactors(patches, method, resolution, hemicube=hemicube).matrix()
         check_solvable(F, patches.rho, lambda p=patches: _rho_names(scene, p))
-        B = _solve_quick(F, patches)
+        B = _solve_quick(F, patches, sources(scene, patches, accel))
         chosen = _refine_candidates(patches, B / math.pi, splits)
         if len(chosen) == 0:
             break
@@ -171,9 +206,11 @@ def mesh_scene(scene: Scene, count: int, method: str = "raycast", adaptive: bool
     return patches
 
 
-def _solve_quick(F: np.ndarray, patches: PatchSet) -> np.ndarray:
+def _solve_quick(F: np.ndarray, patches: PatchSet, E: np.ndarray | None = None) -> np.ndarray:
+    """B of (I - rho F) B = E (default E: the emitters' pi * Le alone)."""
+    E = patches.E if E is None else E
     n = len(F)
-    return np.stack([np.linalg.solve(np.eye(n) - patches.rho[:, c, None] * F, patches.E[:, c])
+    return np.stack([np.linalg.solve(np.eye(n) - patches.rho[:, c, None] * F, E[:, c])
                      for c in range(3)], axis=1)
 
 
@@ -245,6 +282,7 @@ def iter_radiosity(scene: Scene, size: tuple[int, int] | None = None, patches: i
     precheck(scene, count, method)
     start = time.perf_counter()
     stats = {"form_factors": method, "solver": solver, "target_patches": count}
+    accel = scene_accel(scene)
     yield Progress(None, 0.0, "meshing", dict(stats))
     refine = adaptive and count >= 8
     mesh = base_patches(scene, max(1, int(count * REFINE_SHARE)) if refine else count, meshing)
@@ -255,7 +293,7 @@ def iter_radiosity(scene: Scene, size: tuple[int, int] | None = None, patches: i
         band = (stage / stages, (stage + 1) / stages)
         B = yield from _solve_stage(scene, mesh, method, solver, resolution, size, image_every,
                                     stats, band, start, final=stage == stages - 1,
-                                    hemicube=hemicube)
+                                    hemicube=hemicube, accel=accel)
         if stage == stages - 1:
             break
         budget = count if stage == stages - 2 else len(mesh) + (count - len(mesh)) // 2
@@ -269,15 +307,16 @@ def iter_radiosity(scene: Scene, size: tuple[int, int] | None = None, patches: i
 
 
 def _solve_stage(scene, mesh, method, solver, resolution, size, image_every, stats, band,
-                 start, final, hemicube=None):
+                 start, final, hemicube=None, accel=None):
     """Form factors and a solve of one mesh, yielding progress; returns the display B."""
     settings = scene.radiosity
+    E = sources(scene, mesh, accel, stats)
     ff = FormFactors(mesh, method, resolution, hemicube=hemicube)
     history = new_history()
     stats["history"] = history
     span = band[1] - band[0]
     if solver == "progressive":
-        steps = run_solver(solver, None, mesh.rho, mesh.E, settings.iterations,
+        steps = run_solver(solver, None, mesh.rho, E, settings.iterations,
                            settings.tolerance, row=ff.row, areas=mesh.areas)
     else:
         t0 = time.perf_counter()
@@ -287,7 +326,7 @@ def _solve_stage(scene, mesh, method, solver, resolution, size, image_every, sta
         F = ff.matrix()
         stats["form_factors_s"] = time.perf_counter() - t0
         check_solvable(F, mesh.rho, lambda: _rho_names(scene, mesh))
-        steps = run_solver(solver, F, mesh.rho, mesh.E, settings.iterations,
+        steps = run_solver(solver, F, mesh.rho, E, settings.iterations,
                            settings.tolerance, areas=mesh.areas)
     last = yield from _drive(scene, mesh, steps, history, stats, size, image_every, start,
                              (band[0] + 0.6 * span if solver != "progressive" else band[0],
@@ -309,7 +348,7 @@ def _finish(scene, mesh, B, stats, size, start) -> Iterator[Progress]:
     solution = RadiositySolution(scene, mesh, B, stats, ff)
     stats["solution"] = solution
     image = solution.image(size) if size is not None else None
-    yield Progress(image, 1.0, f"done: {len(mesh)} patches", stats)
+    yield Progress(image, 1.0, f"done: {len(mesh)} patches; {stats.get('light', '')}", stats)
 
 
 def _drive(scene, mesh, steps, history, stats, size, image_every, start, band):
