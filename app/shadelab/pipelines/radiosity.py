@@ -140,7 +140,7 @@ def pipeline_radiosity(scene: Scene, size: tuple[int, int] | None = None,
     from shadelab.radiosity import display
     from shadelab.radiosity.formfactors import FormFactors
     from shadelab.radiosity.patches import check_count, uniform_patches
-    from shadelab.radiosity.solution import check_scene, scene_accel, sources
+    from shadelab.radiosity.solution import check_scene, sources
     from shadelab.radiosity.solvers import check_solvable, run_solver
 
     settings = scene.radiosity
@@ -160,7 +160,7 @@ def pipeline_radiosity(scene: Scene, size: tuple[int, int] | None = None,
     patches, ff, token = cached
     rho, emission = _reflectance(scene, patches)
     light: dict = {}
-    E = sources(scene, patches, scene_accel(scene), light, rho=rho, emission=emission)
+    E = sources(scene, patches, light, rho=rho, emission=emission)
     n = len(patches)
     base = {"patches": n, "form_factors": ff.method, "solver": settings.solver,
             "form_factors_reused": reused, "ff_token": token, "unit": "patches", **light}

@@ -16,9 +16,11 @@ it stood for). ``E_direct`` joins the emitters' pi * Le as the right-hand side o
 B = E + rho F B, so every solver shoots or gathers it from the first step on.
 
 S, the shadow factor, comes from shadow rays (``raytrace.accel``, the shadow casters only, as
-in Whitted) from ``SAMPLES`` points of each patch (the centre and the corners pulled a quarter
-of the way in) to the light; H is their mean. Lights marked ``stand_in`` stand for an emitting
-surface that radiosity meshes itself, and are skipped. Pure numpy + the ray-cast accelerator.
+in Whitted) cast against the patches themselves (:func:`patch_accel`: a clustered mesh's
+patches lie inside the original surface, which would shadow them) from ``SAMPLES`` points
+of each patch (the centre and the corners pulled a quarter of the way in) to the light; H
+is their mean. Lights marked ``stand_in`` stand for an emitting surface that radiosity meshes
+itself, and are skipped. Pure numpy + the ray-cast accelerator.
 """
 
 from __future__ import annotations
@@ -72,14 +74,38 @@ def irradiance(light: Light, points: np.ndarray, normals: np.ndarray,
     return value
 
 
+def patch_accel(scene: Scene, patches: PatchSet):
+    """A ``raytrace.accel`` accelerator of the patches' triangles (two per quad patch), shadow
+    casters after their objects' ``cast_shadows``."""
+    from shadelab.raytrace.accel import SceneGeometry, build_accel
+
+    poly = patches.polygons
+    tris = np.concatenate([poly[:, [0, 1, 2]], poly[:, [0, 2, 3]]])
+    owner = np.concatenate([patches.surface, patches.surface])
+    cross = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
+    length = np.linalg.norm(cross, axis=1)
+    keep = length > 1e-12 * max(float(length.max(initial=0.0)), 1e-300)
+    tris, owner, normals = tris[keep], owner[keep], cross[keep] / length[keep, None]
+    if patches.surfaces:
+        casts = np.array([scene.objects[s.object_index].cast_shadows
+                          for s in patches.surfaces], bool)[owner]
+    else:
+        casts = np.ones(len(tris), bool)
+    points = tris.reshape(-1, 3)
+    diagonal = float(np.linalg.norm(np.ptp(points, axis=0))) if len(points) else 1.0
+    geometry = SceneGeometry(tris, normals, np.repeat(normals[:, None, :], 3, axis=1),
+                             owner, casts, diagonal or 1.0)
+    return build_accel(geometry)
+
+
 def direct_radiosity(scene: Scene, patches: PatchSet, shadows: bool = True,
                      accel=None, rho: np.ndarray | None = None) -> tuple[np.ndarray, dict]:
     """(N, 3) E_direct = rho * H per patch and, per light (by label), the power it puts on
     the patches, sum_i A_i H_i (mean over RGB, the scene's units of pi Ip times area), as
     ``{"label": power}``.
 
-    ``accel``: a ``raytrace.accel`` accelerator of the scene (built here when None and
-    ``shadows``); ``rho``: (N, 3) reflectance (default: the patches' own)."""
+    ``accel``: a ``raytrace.accel`` accelerator (default: :func:`patch_accel`); ``rho``:
+    (N, 3) reflectance (default: the patches' own)."""
     rho = patches.rho if rho is None else rho
     lights = direct_lights(scene)
     n = len(patches)
@@ -90,9 +116,7 @@ def direct_radiosity(scene: Scene, patches: PatchSet, shadows: bool = True,
     occluded, eps = None, 0.0
     if shadows:
         if accel is None:
-            from shadelab.raytrace.accel import build_accel, scene_geometry
-
-            accel = build_accel(scene_geometry(scene))
+            accel = patch_accel(scene, patches)
         eps = scene.raytrace.offset * accel.geometry.diagonal
         occluded = accel.occluded
     points = sample_points(patches).reshape(-1, 3)

@@ -108,7 +108,7 @@ def check_scene(scene: Scene) -> None:
                             f"materials.X.emission or add a light)")
 
 
-def sources(scene: Scene, patches: PatchSet, accel=None, stats: dict | None = None,
+def sources(scene: Scene, patches: PatchSet, stats: dict | None = None,
             rho: np.ndarray | None = None, emission: np.ndarray | None = None) -> np.ndarray:
     """(N, 3) the right-hand side E of B = E + rho F B: the emitters' pi * Le plus the
     lights' direct light reflected, rho * H (the first shot, :mod:`.direct`). ``stats``
@@ -116,24 +116,13 @@ def sources(scene: Scene, patches: PatchSet, accel=None, stats: dict | None = No
     ``rho``, ``emission`` (N, 3): the current materials' (default: the patches' own)."""
     from shadelab.radiosity.direct import describe, direct_radiosity
 
-    E_direct, power = direct_radiosity(scene, patches, accel=accel, rho=rho)
+    E_direct, power = direct_radiosity(scene, patches, rho=rho)
     E_emit = patches.E if emission is None else math.pi * np.asarray(emission, float)
     E = E_emit + E_direct
     if stats is not None:
         emitted = float((patches.areas[:, None] * E_emit).sum() / 3.0)
         stats.update(light_power=power, emitted_power=emitted, light=describe(power, emitted))
     return E
-
-
-def scene_accel(scene: Scene):
-    """The shadow-ray accelerator of the direct light (None when no light needs one)."""
-    from shadelab.radiosity.direct import direct_lights
-
-    if not direct_lights(scene):
-        return None
-    from shadelab.raytrace.accel import build_accel, scene_geometry
-
-    return build_accel(scene_geometry(scene))
 
 
 def precheck(scene: Scene, count: int, method: str = "raycast") -> None:
@@ -188,7 +177,6 @@ def mesh_scene(scene: Scene, count: int, method: str = "raycast", adaptive: bool
     if not adaptive or count < 8:
         return uniform_patches(scene, count)
     patches = uniform_patches(scene, max(1, int(count * REFINE_SHARE)))
-    accel = scene_accel(scene)
     for round_ in range(REFINE_ROUNDS):
         budget = count if round_ == REFINE_ROUNDS - 1 else \
             len(patches) + (count - len(patches)) // 2
@@ -197,7 +185,7 @@ def mesh_scene(scene: Scene, count: int, method: str = "raycast", adaptive: bool
             break
         F = FormFactors(patches, method, resolution, hemicube=hemicube).matrix()
         check_solvable(F, patches.rho, lambda p=patches: _rho_names(scene, p))
-        B = _solve_quick(F, patches, sources(scene, patches, accel))
+        B = _solve_quick(F, patches, sources(scene, patches))
         chosen = _refine_candidates(patches, B / math.pi, splits)
         if len(chosen) == 0:
             break
@@ -282,7 +270,6 @@ def iter_radiosity(scene: Scene, size: tuple[int, int] | None = None, patches: i
     precheck(scene, count, method)
     start = time.perf_counter()
     stats = {"form_factors": method, "solver": solver, "target_patches": count}
-    accel = scene_accel(scene)
     yield Progress(None, 0.0, "meshing", dict(stats))
     refine = adaptive and count >= 8
     mesh = base_patches(scene, max(1, int(count * REFINE_SHARE)) if refine else count, meshing)
@@ -293,7 +280,7 @@ def iter_radiosity(scene: Scene, size: tuple[int, int] | None = None, patches: i
         band = (stage / stages, (stage + 1) / stages)
         B = yield from _solve_stage(scene, mesh, method, solver, resolution, size, image_every,
                                     stats, band, start, final=stage == stages - 1,
-                                    hemicube=hemicube, accel=accel)
+                                    hemicube=hemicube)
         if stage == stages - 1:
             break
         budget = count if stage == stages - 2 else len(mesh) + (count - len(mesh)) // 2
@@ -307,10 +294,10 @@ def iter_radiosity(scene: Scene, size: tuple[int, int] | None = None, patches: i
 
 
 def _solve_stage(scene, mesh, method, solver, resolution, size, image_every, stats, band,
-                 start, final, hemicube=None, accel=None):
+                 start, final, hemicube=None):
     """Form factors and a solve of one mesh, yielding progress; returns the display B."""
     settings = scene.radiosity
-    E = sources(scene, mesh, accel, stats)
+    E = sources(scene, mesh, stats=stats)
     ff = FormFactors(mesh, method, resolution, hemicube=hemicube)
     history = new_history()
     stats["history"] = history
