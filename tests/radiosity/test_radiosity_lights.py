@@ -183,3 +183,27 @@ def test_cli_radiosity_of_the_lecture_preset(gl_ctx, tmp_path, capsys):
                  "--uniform", *lighter]) == 0
     assert out.is_file()
     assert "power onto the patches: key" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("solver", ["direct", "progressive"])
+def test_both_drivers_give_the_same_solution(solver):
+    """run() (uniform) and the viewer's shot-by-shot job share one driver
+    (solution.solver_steps): same patches, same E, same solver, so the same display
+    triangles to 1e-6 (float32 soups), progressive down to the same tolerance."""
+    from shadelab.pipelines import radiosity as pipeline
+    from shadelab.pipelines.radiosity import RadiosityPipeline, pipeline_radiosity, soup
+
+    pipeline._RADIOSITY_CACHE.clear()  # matrix() fills rows by reciprocity, row(i) casts them
+
+    light = {"name": "key", "kind": "point", "position": [0.2, 1.5, 0.1], "Ip": list(IP),
+             "attenuation": "none"}
+    wall = {"name": "wall", "shape": "quad", "material": "white", "normals": "flat",
+            "vertices": [[-1, 0, -1], [1, 0, -1], [1, 2, -1], [-1, 2, -1]]}
+    scene = _scene([light], [_quad("floor", (0.0, 0.0, 0.0), 1.0), wall])
+    scene.radiosity.patches, scene.radiosity.solver = 32, solver
+    scene.radiosity.tolerance = 1e-9
+    *_, last = RadiosityPipeline().run(scene, adaptive=False)
+    solution = last.stats["solution"]
+    *_, view = pipeline_radiosity(scene)
+    np.testing.assert_allclose(view.stats["soup"], soup(solution.display_meshes()), atol=1e-6)
+    assert view.stats["light"] == solution.stats["light"]

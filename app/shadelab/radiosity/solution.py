@@ -293,28 +293,43 @@ def iter_radiosity(scene: Scene, size: tuple[int, int] | None = None, patches: i
         mesh = split_leaves(scene, mesh, chosen)
 
 
+def solver_steps(scene: Scene, mesh: PatchSet, ff: FormFactors, solver: str, stats: dict,
+                 band: tuple[float, float] = (0.0, 1.0), rho: np.ndarray | None = None,
+                 emission: np.ndarray | None = None, row=None):
+    """The one driver of both ways to watch radiosity (``iter_radiosity`` and the viewer's
+    :func:`shadelab.pipelines.radiosity.pipeline_radiosity`): the right-hand side E (emitters
+    plus the lights' first shot, :func:`sources`), then, for a gathering solver, the form
+    factors (yielding progress in the first 60 % of ``band``) and the solvability check;
+    returns the solver's :class:`Step` iterator. Only how the steps are streamed differs.
+    ``rho``, ``emission``: the current materials (default: the mesh's own); ``row``: the
+    progressive solver's row function (default ``ff.row``)."""
+    settings = scene.radiosity
+    rho = mesh.rho if rho is None else rho
+    E = sources(scene, mesh, stats=stats, rho=rho, emission=emission)
+    if solver == "progressive":
+        return run_solver(solver, None, rho, E, settings.iterations, settings.tolerance,
+                          row=row or ff.row, areas=mesh.areas)
+    t0 = time.perf_counter()
+    span = band[1] - band[0]
+    for done in ff.iter_matrix():
+        yield Progress(None, band[0] + 0.6 * span * done,
+                       f"form factors {int(done * 100)}% ({len(mesh)} patches)", dict(stats))
+    F = ff.matrix()
+    stats["form_factors_s"] = time.perf_counter() - t0
+    check_solvable(F, rho, lambda: _rho_names(scene, mesh))
+    return run_solver(solver, F, rho, E, settings.iterations, settings.tolerance,
+                      areas=mesh.areas)
+
+
 def _solve_stage(scene, mesh, method, solver, resolution, size, image_every, stats, band,
                  start, final, hemicube=None):
     """Form factors and a solve of one mesh, yielding progress; returns the display B."""
     settings = scene.radiosity
-    E = sources(scene, mesh, stats=stats)
     ff = FormFactors(mesh, method, resolution, hemicube=hemicube)
     history = new_history()
     stats["history"] = history
     span = band[1] - band[0]
-    if solver == "progressive":
-        steps = run_solver(solver, None, mesh.rho, E, settings.iterations,
-                           settings.tolerance, row=ff.row, areas=mesh.areas)
-    else:
-        t0 = time.perf_counter()
-        for done in ff.iter_matrix():
-            yield Progress(None, band[0] + 0.6 * span * done,
-                           f"form factors {int(done * 100)}% ({len(mesh)} patches)", dict(stats))
-        F = ff.matrix()
-        stats["form_factors_s"] = time.perf_counter() - t0
-        check_solvable(F, mesh.rho, lambda: _rho_names(scene, mesh))
-        steps = run_solver(solver, F, mesh.rho, E, settings.iterations,
-                           settings.tolerance, areas=mesh.areas)
+    steps = yield from solver_steps(scene, mesh, ff, solver, stats, band)
     last = yield from _drive(scene, mesh, steps, history, stats, size, image_every, start,
                              (band[0] + 0.6 * span if solver != "progressive" else band[0],
                               band[1]))
