@@ -70,5 +70,6 @@ def run_radiosity(args: argparse.Namespace) -> int:
     print(f"wrote {args.output} ({size[0]}x{size[1]}): {stats['patches']} patches, "
           f"{stats['form_factors']} form factors, {stats['solver']} solver, "
           f"{len(stats['history']['iteration'])} iterations, {stats['total_s']:.2f} s"
-          + ("" if stats["converged"] else " (not converged: raise radiosity.iterations)"))
+          + ("" if stats["converged"] else " (not converged: raise radiosity.iterations)")
+          + f"; {stats['light']}")
     return 0

@@ -10,8 +10,10 @@ One driver, two ways to watch it:
   (progressive refinement), the display triangles (``stats["soup"]``) after each chunk of shots
   with the patch that shot last; the GPU draws them under the live camera. Patches and
   form-factor rows stay in the worker between jobs, so a material or emission edit re-solves
-  without re-meshing (``stats["form_factors_reused"]``). Both use the same patches, form
-  factors and solvers (:mod:`shadelab.radiosity`).
+  without re-meshing (``stats["form_factors_reused"]``). Both mesh with
+  :func:`shadelab.radiosity.solution.base_patches` and start the solver through one function,
+  :func:`shadelab.radiosity.solution.solver_steps` (right-hand side with the lights' first
+  shot, form factors, solvability check): only how the steps are streamed differs.
 """
 
 from __future__ import annotations
@@ -140,9 +142,8 @@ def pipeline_radiosity(scene: Scene, size: tuple[int, int] | None = None,
     ``step_shots`` > 0 yields after every that many shots (the step button)."""
     from shadelab.radiosity import display
     from shadelab.radiosity.formfactors import FormFactors
-    from shadelab.radiosity.patches import check_count, uniform_patches
-    from shadelab.radiosity.solution import check_scene
-    from shadelab.radiosity.solvers import check_solvable, run_solver
+    from shadelab.radiosity.patches import check_count
+    from shadelab.radiosity.solution import base_patches, check_scene, solver_steps
 
     settings = scene.radiosity
     check_count(settings.patches, "radiosity.patches")
@@ -153,14 +154,13 @@ def pipeline_radiosity(scene: Scene, size: tuple[int, int] | None = None,
     reused = cached is not None
     if cached is None:
         yield Progress(None, 0.0, "meshing", {"unit": "patches"})
-        patches = uniform_patches(scene, settings.patches)
+        patches = base_patches(scene, settings.patches, "uniform")
         ff = FormFactors(patches, ff_method(scene), settings.hemicube_resolution)
         cached = (patches, ff, f"ff-{time.time_ns()}")
         _RADIOSITY_CACHE.clear()  # one geometry at a time: the rows can be large
         _RADIOSITY_CACHE[key] = cached
     patches, ff, token = cached
     rho, emission = _reflectance(scene, patches)
-    E = math.pi * emission
     n = len(patches)
     base = {"patches": n, "form_factors": ff.method, "solver": settings.solver,
             "form_factors_reused": reused, "ff_token": token, "unit": "patches"}
@@ -170,15 +170,11 @@ def pipeline_radiosity(scene: Scene, size: tuple[int, int] | None = None,
         shooter[0] = i
         return ff.row(i)
 
-    if settings.solver == "progressive":
-        steps = run_solver("progressive", None, rho, E, settings.iterations, settings.tolerance,
-                           row=row, areas=patches.areas)
-    else:
-        yield Progress(None, 0.05, f"form factors ({n} patches)", dict(base))
-        F = ff.matrix()
-        check_solvable(F, rho)
-        steps = run_solver(settings.solver, F, rho, E, settings.iterations, settings.tolerance,
-                           areas=patches.areas)
+    # the same driver as run(): right-hand side with the lights' first shot, form factors,
+    # solver; only the streaming below differs (form factors here may come from the cache)
+    steps = yield from solver_steps(scene, patches, ff, settings.solver, base, (0.0, 0.05),
+                                    rho=rho, emission=emission, row=row)
+    base.pop("form_factors_s", None)
     history = {"iteration": [], "residual": [], "unshot": []}
     last, last_yield, since = None, 0.0, 0
     for last in steps:
@@ -217,6 +213,6 @@ def _radiosity_progress(patches, rho, step, shooter, history, base, start, displ
         stats["shooter"] = np.asarray(patches.polygons[shooter], np.float32)
         stats["shooter_index"] = int(shooter)
     return Progress(None, max(fraction, 0.0), ("done: " if final else "") + what
-                    + f" ({len(patches)} patches)", stats)
+                    + f" ({len(patches)} patches; {base['light']})", stats)
 
 

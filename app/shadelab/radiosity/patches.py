@@ -6,7 +6,12 @@ where the radiosity changes fast (shadow boundaries, corners), so that flat regi
 coarse. Leaves are stored in integer coordinates at the finest level (``FINE`` units per base
 cell), which lets the display find T-vertices exactly. Any other shape (spheres, boxes, mesh
 files) keeps its triangles, each cut regularly into k x k smaller ones with the same k over the
-whole object, which is conforming by construction.
+whole object, which is conforming by construction. When keeping one patch per triangle would
+exceed the budget (a 100k-triangle scan on a floor), the mesh objects are *clustered* instead:
+vertex clustering on a spatial grid (Rossignac & Borrel 1993) merges the vertices of each grid
+cell into their mean, so each patch is one triangle of the coarser mesh standing for the
+original triangles around it; the grid is the finest that keeps the object within its share
+of the budget (:func:`cluster_mesh`), so the patch count never exceeds ``count``.
 
 Every patch is stored as a 4-corner polygon (a triangle repeats its last corner), counter-
 clockwise seen from the front: the form factors, the hemicube and the display read one layout.
@@ -25,6 +30,8 @@ from shadelab.scene.model import Scene
 from shadelab.shading.packing import reflectance
 
 MAX_LEVEL = 6  # quadtree depth below the base grid
+CLUSTER_ROUNDS = 40  # bisection steps on the clustering grid's cell size
+MESH_SHARE = 0.5  # clustered meshes share at least this part of the budget (the rest by area)
 FINE = 1 << MAX_LEVEL  # integer units per base cell edge
 
 
@@ -174,12 +181,87 @@ def _count_for(surfaces: list[Surface], h: float) -> int:
     return total
 
 
+def cluster_mesh(vertices: np.ndarray, faces: np.ndarray, target: int
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """At most ``target`` triangles standing for ``faces``: vertex clustering on the finest
+    regular grid (bisection on its cell size) that leaves no more; each cell's vertices merge
+    into their mean, collapsed and repeated triangles go. The input when it already fits."""
+    vertices = np.asarray(vertices, float)
+    faces = np.asarray(faces, np.int64)
+    target = max(1, int(target))
+    if len(faces) <= target:
+        return vertices, faces
+    lo_corner = vertices.min(axis=0)
+    extent = max(float(np.ptp(vertices, axis=0).max()), 1e-12)
+
+    def clustered(cell: float):
+        cells = np.floor((vertices - lo_corner) / cell).astype(np.int64)
+        side = int(cells.max()) + 1
+        keys = (cells[:, 0] * side + cells[:, 1]) * side + cells[:, 2]
+        _, inverse = np.unique(keys, return_inverse=True)
+        inverse = inverse.reshape(-1)
+        counts = np.bincount(inverse)
+        merged = np.zeros((len(counts), 3))
+        np.add.at(merged, inverse, vertices)
+        merged /= counts[:, None]
+        f = inverse[faces]
+        f = f[(f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2])]
+        if len(f):
+            g = np.sort(f, axis=1)
+            n = int(g.max()) + 1
+            _, first = np.unique((g[:, 0] * n + g[:, 1]) * n + g[:, 2], return_index=True)
+            f = f[np.sort(first)]
+            tri = merged[f]
+            area = np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+            f = f[area > 1e-12 * extent * extent]
+        used, f = np.unique(f, return_inverse=True)
+        return merged[used], f.reshape(-1, 3)
+
+    lo = extent / max(math.sqrt(target), 1.0) / 16.0  # fine enough to keep > target
+    hi = extent * 1.01  # one cell: no triangle left
+    best = clustered(hi)
+    for _ in range(CLUSTER_ROUNDS):
+        mid = math.sqrt(lo * hi)
+        v, f = clustered(mid)
+        if len(f) <= target:
+            hi, best = mid, (v, f)
+        else:
+            lo = mid
+        if hi / lo < 1.01:
+            break
+    return best
+
+
+def _cluster_targets(surfaces: list[Surface], count: int) -> dict[int, int]:
+    """Per mesh surface (index): its patch budget when meshes must be clustered: its area
+    share of ``count``, at least an equal part of ``MESH_SHARE`` of it."""
+    mesh = [i for i, s in enumerate(surfaces) if s.kind == "mesh"]
+    total = sum(_surface_area(s) for s in surfaces)
+    floor_share = max(1, int(MESH_SHARE * count) // max(len(mesh), 1))
+    targets = {i: min(len(surfaces[i].faces),
+                      max(floor_share, int(count * _surface_area(surfaces[i]) / total)))
+               for i in mesh}
+    room = count - sum(1 for s in surfaces if s.kind == "quad")  # a quad keeps one cell
+    scale = min(1.0, room / max(sum(targets.values()), 1))
+    return {i: max(1, int(t * scale)) for i, t in targets.items()}
+
+
+def _quad_count(surfaces: list[Surface], h: float) -> int:
+    return sum(int(np.prod(_quad_grid(s.corners, h))) for s in surfaces if s.kind == "quad")
+
+
 def uniform_patches(scene: Scene, count: int) -> PatchSet:
-    """A regular meshing with about ``count`` patches of equal size (no refinement)."""
+    """A regular meshing with about ``count`` patches of equal size (no refinement); mesh
+    objects whose triangles alone would exceed ``count`` are clustered, and then the patch
+    count is at most ``count`` (see the module docstring)."""
     count = check_count(count)
     surfaces = scene_surfaces(scene)
     if not surfaces:
         raise ShadeLabError("objects: the scene has no surfaces to mesh into patches")
+    mesh_faces = sum(len(s.faces) for s in surfaces if s.kind == "mesh")
+    quads = sum(1 for s in surfaces if s.kind == "quad")
+    if mesh_faces and mesh_faces + quads > count:
+        return _clustered_patches(scene, surfaces, count)
     total = sum(_surface_area(s) for s in surfaces)
     # Find the patch size h whose meshing comes closest to the target count (bisection on log h)
     # (capped near the mean patch size, so that mesh objects, which keep one patch per
@@ -206,6 +288,44 @@ def uniform_patches(scene: Scene, count: int) -> PatchSet:
             k = max(1, int(round(math.sqrt(per) / h)))
             s.vertices, s.faces = _mesh_split(s.vertices, s.faces, k)
     return assemble(scene, surfaces, leaves)
+
+
+def _clustered_patches(scene: Scene, surfaces: list[Surface], count: int) -> PatchSet:
+    """Meshes clustered to their share of ``count`` (:func:`_cluster_targets`), quads on the
+    regular grid of the coarsest size h that fits the rest (at least one cell each)."""
+    import time
+
+    start = time.perf_counter()
+    targets = _cluster_targets(surfaces, count)
+    triangles_in = sum(len(surfaces[i].faces) for i in targets)
+    for index, target in targets.items():
+        s = surfaces[index]
+        s.vertices, s.faces = cluster_mesh(s.vertices, s.faces, target)
+    rest = count - sum(len(surfaces[i].faces) for i in targets)
+    quad_area = sum(_surface_area(s) for s in surfaces if s.kind == "quad")
+    leaves = []
+    if quad_area > 0.0:
+        lo = math.sqrt(quad_area / max(rest, 1)) / 8.0
+        hi = max(math.sqrt(quad_area / max(rest, 1)) * 4.0,
+                 max(float(np.ptp(s.corners, axis=0).max()) for s in surfaces
+                     if s.kind == "quad") * 2.0)
+        for _ in range(40):
+            mid = math.sqrt(lo * hi)
+            if _quad_count(surfaces, mid) > rest:
+                lo = mid
+            else:
+                hi = mid
+        for index, s in enumerate(surfaces):
+            if s.kind != "quad":
+                continue
+            s.grid = _quad_grid(s.corners, hi)
+            for i in range(s.grid[0]):
+                for j in range(s.grid[1]):
+                    leaves.append((index, i * FINE, j * FINE, (i + 1) * FINE, (j + 1) * FINE))
+    patches = assemble(scene, surfaces, leaves)
+    patches.info.update(clustered=True, clustering_s=time.perf_counter() - start,
+                        mesh_triangles=triangles_in)
+    return patches
 
 
 def assemble(scene: Scene, surfaces: list[Surface], leaves: list[tuple]) -> PatchSet:
@@ -242,7 +362,16 @@ def assemble(scene: Scene, surfaces: list[Surface], leaves: list[tuple]) -> Patc
                        np.asarray(rects, np.int64).reshape(-1, 4)[keep],
                        np.asarray(tris, np.int64).reshape(-1, 3)[keep])
     patches.info["patches"] = len(patches)
+    check_made(len(patches))
     return patches
+
+
+def check_made(made: int) -> None:
+    """The patch limit (:data:`shadelab.limits.MAX_PATCHES`) on the patches really made."""
+    from shadelab import limits
+
+    limits.check(f"radiosity: {made} patches made", made, limits.MAX_PATCHES, "patches",
+                 8.0 * made * made)
 
 
 def leaf_corners(surfaces: list[Surface], table: np.ndarray) -> np.ndarray:

@@ -95,11 +95,34 @@ class RadiositySolution:
 
 # ---------------------------------------------------------------------- checks
 def check_scene(scene: Scene) -> None:
-    """Refuse a scene radiosity cannot light: nothing emits."""
+    """Refuse a scene radiosity cannot light: nothing emits and no point, spot or directional
+    light (other than a ``stand_in``) is on."""
+    from shadelab.radiosity.direct import direct_lights
+
     used = {obj.material for obj in scene.objects}
+    if direct_lights(scene):
+        return
     if not any(max(scene.materials[m].emission) > 0.0 for m in used if m in scene.materials):
         raise ShadeLabError(f"{scene.name or 'scene'}: no object has a material with emission "
-                            f"> 0, so radiosity has no light to spread (set materials.X.emission)")
+                            f"> 0 and no light is on, so radiosity has no light to spread (set "
+                            f"materials.X.emission or add a light)")
+
+
+def sources(scene: Scene, patches: PatchSet, stats: dict | None = None,
+            rho: np.ndarray | None = None, emission: np.ndarray | None = None) -> np.ndarray:
+    """(N, 3) the right-hand side E of B = E + rho F B: the emitters' pi * Le plus the
+    lights' direct light reflected, rho * H (the first shot, :mod:`.direct`). ``stats``
+    gets ``light_power`` (per light), ``emitted_power`` and the one-line ``light``.
+    ``rho``, ``emission`` (N, 3): the current materials' (default: the patches' own)."""
+    from shadelab.radiosity.direct import describe, direct_radiosity
+
+    E_direct, power = direct_radiosity(scene, patches, rho=rho)
+    E_emit = patches.E if emission is None else math.pi * np.asarray(emission, float)
+    E = E_emit + E_direct
+    if stats is not None:
+        emitted = float((patches.areas[:, None] * E_emit).sum() / 3.0)
+        stats.update(light_power=power, emitted_power=emitted, light=describe(power, emitted))
+    return E
 
 
 def precheck(scene: Scene, count: int, method: str = "raycast") -> None:
@@ -162,7 +185,7 @@ def mesh_scene(scene: Scene, count: int, method: str = "raycast", adaptive: bool
             break
         F = FormFactors(patches, method, resolution, hemicube=hemicube).matrix()
         check_solvable(F, patches.rho, lambda p=patches: _rho_names(scene, p))
-        B = _solve_quick(F, patches)
+        B = _solve_quick(F, patches, sources(scene, patches))
         chosen = _refine_candidates(patches, B / math.pi, splits)
         if len(chosen) == 0:
             break
@@ -171,9 +194,11 @@ def mesh_scene(scene: Scene, count: int, method: str = "raycast", adaptive: bool
     return patches
 
 
-def _solve_quick(F: np.ndarray, patches: PatchSet) -> np.ndarray:
+def _solve_quick(F: np.ndarray, patches: PatchSet, E: np.ndarray | None = None) -> np.ndarray:
+    """B of (I - rho F) B = E (default E: the emitters' pi * Le alone)."""
+    E = patches.E if E is None else E
     n = len(F)
-    return np.stack([np.linalg.solve(np.eye(n) - patches.rho[:, c, None] * F, patches.E[:, c])
+    return np.stack([np.linalg.solve(np.eye(n) - patches.rho[:, c, None] * F, E[:, c])
                      for c in range(3)], axis=1)
 
 
@@ -268,6 +293,34 @@ def iter_radiosity(scene: Scene, size: tuple[int, int] | None = None, patches: i
         mesh = split_leaves(scene, mesh, chosen)
 
 
+def solver_steps(scene: Scene, mesh: PatchSet, ff: FormFactors, solver: str, stats: dict,
+                 band: tuple[float, float] = (0.0, 1.0), rho: np.ndarray | None = None,
+                 emission: np.ndarray | None = None, row=None):
+    """The one driver of both ways to watch radiosity (``iter_radiosity`` and the viewer's
+    :func:`shadelab.pipelines.radiosity.pipeline_radiosity`): the right-hand side E (emitters
+    plus the lights' first shot, :func:`sources`), then, for a gathering solver, the form
+    factors (yielding progress in the first 60 % of ``band``) and the solvability check;
+    returns the solver's :class:`Step` iterator. Only how the steps are streamed differs.
+    ``rho``, ``emission``: the current materials (default: the mesh's own); ``row``: the
+    progressive solver's row function (default ``ff.row``)."""
+    settings = scene.radiosity
+    rho = mesh.rho if rho is None else rho
+    E = sources(scene, mesh, stats=stats, rho=rho, emission=emission)
+    if solver == "progressive":
+        return run_solver(solver, None, rho, E, settings.iterations, settings.tolerance,
+                          row=row or ff.row, areas=mesh.areas)
+    t0 = time.perf_counter()
+    span = band[1] - band[0]
+    for done in ff.iter_matrix():
+        yield Progress(None, band[0] + 0.6 * span * done,
+                       f"form factors {int(done * 100)}% ({len(mesh)} patches)", dict(stats))
+    F = ff.matrix()
+    stats["form_factors_s"] = time.perf_counter() - t0
+    check_solvable(F, rho, lambda: _rho_names(scene, mesh))
+    return run_solver(solver, F, rho, E, settings.iterations, settings.tolerance,
+                      areas=mesh.areas)
+
+
 def _solve_stage(scene, mesh, method, solver, resolution, size, image_every, stats, band,
                  start, final, hemicube=None):
     """Form factors and a solve of one mesh, yielding progress; returns the display B."""
@@ -276,19 +329,7 @@ def _solve_stage(scene, mesh, method, solver, resolution, size, image_every, sta
     history = new_history()
     stats["history"] = history
     span = band[1] - band[0]
-    if solver == "progressive":
-        steps = run_solver(solver, None, mesh.rho, mesh.E, settings.iterations,
-                           settings.tolerance, row=ff.row, areas=mesh.areas)
-    else:
-        t0 = time.perf_counter()
-        for done in ff.iter_matrix():
-            yield Progress(None, band[0] + 0.6 * span * done,
-                           f"form factors {int(done * 100)}% ({len(mesh)} patches)", dict(stats))
-        F = ff.matrix()
-        stats["form_factors_s"] = time.perf_counter() - t0
-        check_solvable(F, mesh.rho, lambda: _rho_names(scene, mesh))
-        steps = run_solver(solver, F, mesh.rho, mesh.E, settings.iterations,
-                           settings.tolerance, areas=mesh.areas)
+    steps = yield from solver_steps(scene, mesh, ff, solver, stats, band)
     last = yield from _drive(scene, mesh, steps, history, stats, size, image_every, start,
                              (band[0] + 0.6 * span if solver != "progressive" else band[0],
                               band[1]))
@@ -309,7 +350,7 @@ def _finish(scene, mesh, B, stats, size, start) -> Iterator[Progress]:
     solution = RadiositySolution(scene, mesh, B, stats, ff)
     stats["solution"] = solution
     image = solution.image(size) if size is not None else None
-    yield Progress(image, 1.0, f"done: {len(mesh)} patches", stats)
+    yield Progress(image, 1.0, f"done: {len(mesh)} patches; {stats.get('light', '')}", stats)
 
 
 def _drive(scene, mesh, steps, history, stats, size, image_every, start, band):
