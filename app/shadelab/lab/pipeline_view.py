@@ -67,8 +67,10 @@ def view_of(state) -> PipelineView:
 
 
 def current(state) -> str:
-    """The pipeline shown: ``state.view.pipeline``, or the raster one the scene's settings name."""
-    if state.view.pipeline in PIPELINES:
+    """The pipeline shown: an offline ``state.view.pipeline``, else the raster one the scene's
+    settings name (the scene is the truth for raster: a lesson step, undo or the Shading
+    radio may change them after the choice, and the selector must agree with Shading)."""
+    if state.view.pipeline in PIPELINES and state.view.pipeline not in RASTER:
         return state.view.pipeline
     render = state.scene.render
     if render.visibility == "painter":

@@ -71,6 +71,7 @@ class ViewState:
     tonemap: str = "clamp"            # display: clamp | reinhard
     show_clipping: bool = False       # display: paint clipped pixels
     show_fps: bool = True             # fps / frame-time readout in the viewport
+    fps_in_presenter: bool = False    # ... in presenter mode too (off: the class sees none)
     antialias: int = 1                # supersampling factor of the scene pass (1 or 2)
     msaa: int = 1                     # MSAA samples of the scene pass (1, 2, 4, 8)
     msaa_limit: int = 0               # the most the GL allows (0: not known yet)
@@ -85,6 +86,11 @@ class ViewState:
     wipe_position: float = 0.5        # share of the viewport's width left of the wipe line
     radiosity_patches: bool = False   # radiosity pipeline: draw the patch edges
     pipeline_view: PipelineView | None = None  # the pipeline's jobs and images
+
+    @property
+    def fps_shown(self) -> bool:
+        """The fps readout is drawn: asked for, and in presenter mode asked for there too."""
+        return self.show_fps and (not self.presenter or self.fps_in_presenter)
 
 
 @dataclass

@@ -246,7 +246,7 @@ def fps_text(redrawn: bool) -> str:
 def readout_width(state: AppState) -> float:
     """Screen width the fps readout takes at the viewport's top right (0 when hidden): the
     pipeline status line wraps before it instead of running under it."""
-    return imgui.calc_text_size(fps_text(True)).x + 24.0 if state.view.show_fps else 0.0
+    return imgui.calc_text_size(fps_text(True)).x + 24.0 if state.view.fps_shown else 0.0
 
 
 def caption_scale(state: AppState) -> float:
@@ -295,7 +295,7 @@ def draw_viewport_extras(state: AppState, origin, size, redrawn: bool,
     compare at the bottom right, clear of the panes' labels) and the caption in the ``band``
     pixels under it (over the image's bottom when no band was kept)."""
     draw = imgui.get_window_draw_list()
-    if state.view.show_fps:
+    if state.view.fps_shown:
         text = fps_text(redrawn)
         width = imgui.calc_text_size(text).x
         line = imgui.get_font_size()
@@ -330,7 +330,11 @@ def draw_display_panel(state: AppState) -> bool:
     _, state.view.show_clipping = imgui.checkbox("Show clipped pixels (stripes)",
                                                  state.view.show_clipping)
     draw_antialias_choice(state)
-    _, state.view.show_fps = imgui.checkbox("fps readout", state.view.show_fps)
+    if state.view.presenter:  # off by default in front of a class
+        _, state.view.fps_in_presenter = imgui.checkbox("fps readout",
+                                                        state.view.fps_in_presenter)
+    else:
+        _, state.view.show_fps = imgui.checkbox("fps readout", state.view.show_fps)
     _, state.view.line_width = imgui.slider_float("line width", state.view.line_width, 0.0, 8.0,
                                              "%.1f px" if state.view.line_width > 0 else "auto")
     imgui.set_item_tooltip("0: by the presenter scale (>= 3 px in presenter mode)")
