@@ -71,9 +71,11 @@ def test_kd_slider_changes_the_pixel_as_the_reference_predicts(xdisplay, tmp_pat
     from PIL import Image
 
     shot = np.asarray(Image.open(tmp_path / r["screenshots"][0]))
-    assert shot.shape == (r["viewport"][1], r["viewport"][0], 3)
-    band = shot[-20:, :200].astype(int)
-    assert (band > 200).any() and (band < 60).any()  # white legend text on the dark band
+    h, w = r["viewport"][1], r["viewport"][0]
+    assert shot.shape[1:] == (w, 3) and shot.shape[0] > h + 20  # the legend in a margin
+    band = shot[h:, :200].astype(int)
+    assert (band > 200).any() and (band < 60).any()  # white legend text on the dark margin
+    assert r["toast"].startswith("saved ") and r["toast"].endswith(r["screenshots"][0])
 
 
 def test_three_shading_modes_by_key_and_button(xdisplay, tmp_path):
@@ -195,6 +197,7 @@ def scenario_kd_slider(ctx, state, out: dict) -> None:
     ctx.key_press(imgui_key("s"))  # viewport screenshot with the legend burned in
     ctx.yield_(3)
     out["screenshots"] = sorted(p.name for p in Path(OUT_DIR).glob("shadelab-*.png"))
+    out["toast"] = state.toast[0]
     out["viewport"] = list(state.view.viewport_size)
 
 

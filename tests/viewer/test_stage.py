@@ -30,3 +30,28 @@ def test_no_fps_readout_in_presenter_mode_unless_asked():
     assert view.fps_shown
     view.show_fps = False
     assert not view.fps_shown
+
+
+def test_screenshots_go_to_the_pictures_folder_and_are_announced(tmp_path, monkeypatch):
+    import numpy as np
+
+    from shadelab.lab.state import default_screenshot_dir
+    from shadelab.ui.viewport_reads import write_viewport_screenshot
+
+    monkeypatch.delenv("SHADELAB_SCREENSHOT_DIR", raising=False)
+    monkeypatch.setenv("XDG_PICTURES_DIR", str(tmp_path / "Bilder"))
+    assert default_screenshot_dir() == str(tmp_path / "Bilder" / "ShadeLab")
+    monkeypatch.delenv("XDG_PICTURES_DIR")
+    monkeypatch.setenv("HOME", str(tmp_path))
+    assert default_screenshot_dir() == str(tmp_path / "Pictures" / "ShadeLab")
+    state = AppState.from_scene(load_preset("cornell"), "cornell")
+    assert state.screenshot_dir == str(tmp_path / "Pictures" / "ShadeLab")
+
+    class Shown:
+        def read_display(self, key):
+            return np.zeros((30, 40, 3), np.uint8)
+
+    path = tmp_path / "Pictures" / "ShadeLab" / "shot.png"   # the folder is made on the save
+    write_viewport_screenshot(state, Shown(), str(path))
+    assert path.is_file() and not state.error
+    assert state.toast[0] == f"saved {path}"

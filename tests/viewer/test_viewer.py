@@ -282,15 +282,16 @@ def test_available_jobs_lists_every_renderer_with_a_reason_when_missing():
         assert (kind.make is None) == bool(kind.reason)
 
 
-def test_legend_is_burned_into_the_bottom_band():
+def test_legend_is_written_in_a_margin_under_the_image():
     from shadelab.lab.legend import burn_legend, legend_lines
 
     state = AppState.from_scene(load_preset("cornell"), "cornell")
     image = np.full((200, 300, 3), 128, np.uint8)
     out = burn_legend(image, state)
-    assert out.shape == image.shape
-    assert np.array_equal(out[:100], image[:100])
-    assert not np.array_equal(out[-30:], image[-30:])
+    assert out.shape[1:] == image.shape[1:] and out.shape[0] > image.shape[0] + 20
+    assert np.array_equal(out[:200], image)          # the picture is whole: nothing covered
+    margin = out[200:].astype(int)
+    assert (margin > 200).any() and (margin < 60).any()  # white text on the dark margin
     assert "Phong shading" in legend_lines(state)[0].replace("phong shading", "Phong shading")
 
 

@@ -97,7 +97,8 @@ def test_viewport_screenshot_is_the_shown_image(tmp_path, np_rng):
 
 def test_viewport_screenshot_to_a_bad_path_is_one_line(tmp_path):
     state = _state()
-    path = tmp_path / "no-such-folder" / "shot.png"
+    (tmp_path / "a-file").write_text("a file where a folder is expected")
+    path = tmp_path / "a-file" / "shot.png"   # (a missing folder is made: the Pictures one)
     write_viewport_screenshot(state, _Shown(np.zeros((4, 4, 3), np.uint8)), str(path))
     assert state.error.startswith(f"screenshot '{path}': cannot write (")
     assert "\n" not in state.error and not path.exists()

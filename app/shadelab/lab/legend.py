@@ -1,4 +1,4 @@
-"""Burn a legend of the current parameters into a viewport screenshot (PIL)."""
+"""A legend of the current parameters in a margin under a viewport screenshot (PIL)."""
 
 from __future__ import annotations
 
@@ -26,18 +26,19 @@ def legend_lines(state: AppState) -> list[str]:
 
 
 def burn_legend(image: np.ndarray, state: AppState) -> np.ndarray:
-    """The (H, W, 3) uint8 image with the parameters written on a dark band at the bottom."""
+    """The (H, W, 3) uint8 image with the parameters written in a dark margin added under it
+    ((H + margin, W, 3)): the legend never covers the picture."""
     lines = legend_lines(state)
-    pil = Image.fromarray(image)
     size = max(10, min(16, image.shape[0] // 40))
     try:
         font = ImageFont.load_default(size=size)
     except TypeError:  # Pillow < 10.1 has one bitmap size
         font = ImageFont.load_default()
     band = (size + 4) * len(lines) + 6
-    draw = ImageDraw.Draw(pil, "RGBA")
-    h = image.shape[0]
-    draw.rectangle([0, h - band, image.shape[1], h], fill=(0, 0, 0, 170))
+    h, w = image.shape[:2]
+    pil = Image.new("RGB", (w, h + band), (16, 16, 16))
+    pil.paste(Image.fromarray(image), (0, 0))
+    draw = ImageDraw.Draw(pil)
     for i, text in enumerate(lines):
-        draw.text((6, h - band + 4 + i * (size + 4)), text, fill=(255, 255, 255, 255), font=font)
+        draw.text((6, h + 4 + i * (size + 4)), text, fill=(255, 255, 255), font=font)
     return np.asarray(pil)

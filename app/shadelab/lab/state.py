@@ -41,6 +41,18 @@ if TYPE_CHECKING:  # types only (no import at run time: the GL side stays out of
     from shadelab.raytrace.tree import RayNode
 
 COMPARE_VIEWS = (("flat", "phong"), ("gouraud", "phong"), ("phong", "phong"), ("phong", "blinn"))
+def default_screenshot_dir() -> str:
+    """Where S saves: $SHADELAB_SCREENSHOT_DIR, else the desktop's Pictures folder
+    ($XDG_PICTURES_DIR or ~/Pictures) / ShadeLab (made on the first save)."""
+    import os
+
+    own = os.environ.get("SHADELAB_SCREENSHOT_DIR")
+    if own:
+        return own
+    pictures = os.environ.get("XDG_PICTURES_DIR") or str(Path.home() / "Pictures")
+    return str(Path(pictures) / "ShadeLab")
+
+
 COMPARE_LABELS = ("Flat", "Gouraud", "Phong", "Blinn-Phong")
 AUTOSAVE_INTERVAL = 1.0      # seconds between autosaves of a changed scene
 
@@ -178,7 +190,8 @@ class AppState:
     # Files
     preset_path: str = ""             # "Save" writes here
     open_path: str = ""               # text field of the open/save box
-    screenshot_dir: str = "."
+    screenshot_dir: str = field(default_factory=default_screenshot_dir)
+    toast: tuple[str, float] = ("", 0.0)  # a message over the viewport until monotonic time
     screenshot_requested: str = ""    # a path: the viewport is written there next frame
     pending_open: str = ""            # a file asked for while there are unsaved edits
     # Bookkeeping

@@ -304,12 +304,28 @@ def draw_viewport_extras(state: AppState, origin, size, redrawn: bool,
         draw.add_rect_filled(imgui.ImVec2(pos.x - 4, pos.y - 2),
                              imgui.ImVec2(pos.x + width + 4, pos.y + line + 2), 0x90000000)
         draw.add_text(pos, 0xFFB0FFB0, text)
+    _draw_toast(draw, state, origin, size)
     caption = caption_text(state)
     if band > 0:
         draw_caption(draw, caption, imgui.ImVec2(origin.x, origin.y + size[1]),
                      (size[0], band + 4), caption_scale(state), band)  # measured once a frame
     else:
         draw_caption(draw, caption, origin, size, caption_scale(state))
+
+
+def _draw_toast(draw, state: AppState, origin, size) -> None:
+    """A short message centred at the viewport's top (a saved screenshot) while it lasts."""
+    import time
+
+    text, until = state.toast
+    if not text or time.monotonic() > until:
+        return
+    width = imgui.calc_text_size(text).x
+    line = imgui.get_font_size()
+    pos = imgui.ImVec2(origin.x + max(8.0, (size[0] - width) / 2), origin.y + 8 + line)
+    draw.add_rect_filled(imgui.ImVec2(pos.x - 8, pos.y - 4),
+                         imgui.ImVec2(pos.x + width + 8, pos.y + line + 4), 0xD0202020, 6.0)
+    draw.add_text(pos, 0xFFFFFFFF, text)
 
 
 # ---------------------------------------------------------------- Scene panel section

@@ -3,6 +3,9 @@ value beside its CPU reference, and the viewport screenshot (the S key)."""
 
 from __future__ import annotations
 
+import time
+from pathlib import Path
+
 from shadelab.lab.probe import probe
 from shadelab.lab.state import AppState
 
@@ -38,6 +41,9 @@ def update_probe(state: AppState, viewport, size: tuple[int, int],
         state.status = f"pixel {pixel}: background (no surface)"
 
 
+TOAST_S = 3.0  # seconds a saved screenshot is announced over the viewport
+
+
 def write_viewport_screenshot(state: AppState, viewport, path: str) -> None:
     """The main pane as shown (with the legend burnt in when asked) as a PNG at ``path``;
     a failed write is one line in ``state.error``."""
@@ -49,7 +55,9 @@ def write_viewport_screenshot(state: AppState, viewport, path: str) -> None:
     if state.view.legend_in_screenshot:
         image = burn_legend(image, state)
     try:
+        Path(path).parent.mkdir(parents=True, exist_ok=True)
         Image.fromarray(image).save(path)
         state.status = f"screenshot {path}"
+        state.toast = (f"saved {path}", time.monotonic() + TOAST_S)
     except (OSError, ValueError) as exc:
         state.error = f"screenshot '{path}': cannot write ({exc})"
