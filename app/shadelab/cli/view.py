@@ -244,6 +244,15 @@ def run_view(args: argparse.Namespace) -> int:
         scene, source, restored = _restored_meshes_or_preset(args, scene, source, notes)
     else:
         scene_meshes(scene)  # a broken mesh file fails here, with its one-line reason
+    if args.screenshot:  # not one of the scene's own files either
+        from shadelab.scene.preset import scene_inputs
+
+        inputs = scene_inputs(scene, source)
+        if args.lesson:
+            from shadelab.lab.lesson_file import resolve_lesson
+
+            inputs.append(("lesson", resolve_lesson(args.lesson)))
+        check_writable(args.screenshot, "--screenshot", inputs)
     exercise = None
     if args.exercise:
         from shadelab.exercises import load_exercise
