@@ -87,22 +87,18 @@ def _pixel(text: str, flag: str) -> tuple[int, int]:
     return x, y
 
 
-# The dock windows' labels (shadelab.ui.app._docking), for --focus before any window code.
-PANEL_LABELS = ("Scene", "Lights", "Materials", "Objects", "Viewport", "Equation & probe",
-                "Studies", "Failure gallery", "Offline render", "Algorithms", "Hemicube & F",
-                "Exercise")
+from shadelab.lab.panel_names import PANEL_LABELS, unknown_panel  # noqa: E402
+
 RAY_TREE_HEIGHT = 256    # the offline image's height (OfflineState.size) --ray-tree points in
 RAY_TREE_MAX_ASPECT = 4  # its width: the viewport's aspect times that, at most this times it
 
 
 def check_focus(focus: str) -> None:
     """--focus names dock windows by a label prefix or a word of one (ui.layout.focus_windows)."""
-    wanted = [w.strip().lower() for w in focus.split(",")]
-    for word in wanted:
-        if not word or not any(label.lower().startswith(word) or word in label.lower()
-                               for label in PANEL_LABELS):
-            raise ShadeLabError(f"--focus '{focus}': no panel '{word}'; expected one of "
-                                f"{', '.join(PANEL_LABELS)}")
+    word = unknown_panel(focus)
+    if word is not None:
+        raise ShadeLabError(f"--focus '{focus}': no panel '{word}'; expected one of "
+                            f"{', '.join(PANEL_LABELS)}")
 
 
 def _check_pixels(args: argparse.Namespace, window: tuple[int, int]):
