@@ -108,8 +108,10 @@ def _check_pixels(args: argparse.Namespace, window: tuple[int, int]):
     if probe is not None:
         limit = window if args.window else (MAX_WINDOW, MAX_WINDOW)  # maximized: any monitor
         if probe[0] >= limit[0] or probe[1] >= limit[1]:
-            raise ShadeLabError(f"--probe '{args.probe}': outside the {limit[0]}x{limit[1]} "
-                                "window")
+            where = f"the {limit[0]}x{limit[1]} window" if args.window \
+                else f"any window (x, y < {MAX_WINDOW})"
+            raise ShadeLabError(f"--probe '{args.probe}': outside {where}; expected a pixel "
+                                "of the viewport")
     ray_tree = _pixel(args.ray_tree, "--ray-tree") if args.ray_tree else None
     if ray_tree is not None:
         from shadelab.lab.jobs import find_job
