@@ -50,6 +50,56 @@ def __getattr__(name: str):
 # ---------------------------------------------------------------- images
 
 
+# ---------------------------------------------------------------- argument checks
+# Every public function checks its arguments as a preset is checked: a wrong type or value is
+# one ShadeLabError line naming the argument (never a builtin error from deep inside).
+
+FORM_FACTORS = ("hemicube", "raycast", "analytic")
+
+
+def _is_int(value: Any) -> bool:
+    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
+
+
+def _check_int(name: str, value: Any, lo: int | None = None,
+               hi: int | None = None) -> int | None:
+    """None, or an int in [lo, hi] (no bound where None); anything else is one line."""
+    if value is None:
+        return None
+    expected = (f"an integer in [{lo}, {hi}]" if hi is not None and lo is not None
+                else f"an integer >= {lo}" if lo is not None else "an integer")
+    if not _is_int(value) or (lo is not None and value < lo) or (hi is not None
+                                                                 and value > hi):
+        raise ShadeLabError(f"{name} {value!r}: expected {expected}")
+    return int(value)
+
+
+def _check_choice(name: str, value: Any, choices) -> str | None:
+    if value is None:
+        return None
+    if not isinstance(value, str) or value not in choices:
+        raise ShadeLabError(f"{name} {value!r}: expected one of {', '.join(choices)}")
+    return value
+
+
+def _check_bool(name: str, value: Any, optional: bool = True) -> bool | None:
+    if value is None and optional:
+        return None
+    if not isinstance(value, (bool, np.bool_)):
+        raise ShadeLabError(f"{name} {value!r}: expected True or False")
+    return bool(value)
+
+
+def _check_path(name: str, value: Any, optional: bool = False) -> Path | None:
+    if value is None and optional:
+        return None
+    if not isinstance(value, (str, Path)) or not str(value).strip():
+        raise ShadeLabError(f"{name} {value!r}: expected a file name (str or pathlib.Path)")
+    if "\x00" in str(value):
+        raise ShadeLabError(f"{name} {value!r}: has a NUL character in its name")
+    return Path(value)
+
+
 class Image:
     """A rendered image: linear radiance with its display exposure.
 
@@ -70,9 +120,19 @@ class Image:
     """
 
     def __init__(self, array: Any, exposure: float = 1.0, info: dict | None = None):
-        a = np.ascontiguousarray(array, dtype=np.float32)
+        try:
+            a = np.ascontiguousarray(array, dtype=np.float32)
+        except (TypeError, ValueError):
+            raise ShadeLabError(f"image: expected an (H, W, 3) array of numbers, got "
+                                f"{type(array).__name__}") from None
         if a.ndim != 3 or a.shape[2] != 3:
             raise ShadeLabError(f"image: expected an (H, W, 3) array, got shape {a.shape}")
+        if isinstance(exposure, (bool, np.bool_)) or not isinstance(
+                exposure, (int, float, np.integer, np.floating)) or not np.isfinite(exposure) \
+                or exposure < 0:
+            raise ShadeLabError(f"exposure={exposure!r}: expected a finite number >= 0")
+        if info is not None and not isinstance(info, Mapping):
+            raise ShadeLabError(f"info={info!r}: expected a dict")
         self.array = a
         self.exposure = float(exposure)
         self.info = dict(info or {})
@@ -107,7 +167,7 @@ class Image:
         """
         from shadelab.imageio import check_image_name, check_writable, write_npy, write_png
 
-        path = Path(path)
+        path = _check_path("path", path)
         suffix = path.suffix.lower()
         if suffix not in (".png", ".exr", ".npy"):
             raise ShadeLabError(f"save '{path}': expected a .png or .npy file name, or .exr "
@@ -161,6 +221,9 @@ def _override_items(overrides: Mapping[str, Any] | Sequence[str] | None) -> list
         return []
     if isinstance(overrides, str):
         return [overrides]
+    if not isinstance(overrides, (Mapping, Sequence)) or isinstance(overrides, bytes):
+        raise ShadeLabError(f"overrides={overrides!r}: expected a dict of dotted keys, or a "
+                            "list of 'KEY=VALUE' strings")
     if isinstance(overrides, Mapping):
         import tomli_w
 
@@ -170,6 +233,8 @@ def _override_items(overrides: Mapping[str, Any] | Sequence[str] | None) -> list
                 value = value.tolist()
             if isinstance(value, tuple):
                 value = list(value)
+            if not isinstance(key, str):
+                raise ShadeLabError(f"overrides: key {key!r}: expected a dotted key string")
             try:
                 literal = tomli_w.dumps({"v": value}).split("=", 1)[1].strip()
             except TypeError:
@@ -177,7 +242,10 @@ def _override_items(overrides: Mapping[str, Any] | Sequence[str] | None) -> list
                                     "(expected a number, bool, string or list)") from None
             items.append(f"{key}={literal}")
         return items
-    return [str(item) for item in overrides]
+    for item in overrides:
+        if not isinstance(item, str):
+            raise ShadeLabError(f"overrides: item {item!r}: expected a 'KEY=VALUE' string")
+    return list(overrides)
 
 
 def load_preset(name_or_path: str | Path,
@@ -200,6 +268,7 @@ def load_preset(name_or_path: str | Path,
     """
     from shadelab.scene.preset import load_preset as load
 
+    _check_path("name_or_path", name_or_path)
     return load(str(name_or_path), _override_items(overrides))
 
 
@@ -207,7 +276,10 @@ def save_preset(scene: Scene, path: str | Path) -> None:
     """Write ``scene`` as a TOML preset (round-trips exactly through :func:`load_preset`)."""
     from shadelab.scene.preset import save_preset as save
 
-    save(scene, path)
+    if not isinstance(scene, Scene):
+        raise ShadeLabError(f"scene: expected a Scene (from load_preset), got "
+                            f"{type(scene).__name__}")
+    save(scene, _check_path("path", path))
 
 
 def _scene(scene: Scene | str | Path) -> Scene:
@@ -230,10 +302,12 @@ def _size(size: Any, pipeline: str) -> tuple[int, int]:
     if isinstance(size, (int, np.integer)) and not isinstance(size, bool):
         return parse_size(str(int(size)))
     try:
-        w, h = (int(v) for v in size)
+        w, h = size
     except (TypeError, ValueError):
         raise ShadeLabError(f"size {size!r}: expected (width, height), N or 'WxH'") from None
-    return parse_size(f"{w}x{h}")
+    if not (_is_int(w) and _is_int(h)):
+        raise ShadeLabError(f"size {size!r}: expected (width, height) integers")
+    return parse_size(f"{int(w)}x{int(h)}")
 
 
 # ---------------------------------------------------------------- rendering
@@ -286,8 +360,27 @@ def render(scene: Scene | str, size: Any = None, shading: str | None = None,
         pixel for pixel across pipelines; ``.info`` holds the pipeline and its statistics.
     """
     from shadelab import pipelines
+    from shadelab.cli.raytrace import MAX_SEED
+    from shadelab.raytrace import BACKENDS
+    from shadelab.scene.model import RADIOSITY_SOLVERS
 
     scene = _scene(scene)
+    if not isinstance(pipeline, str):
+        raise ShadeLabError(f"pipeline={pipeline!r}: expected a pipeline name (str)")
+    _check_choice("shading", shading, SHADING_MODES)
+    _check_choice("specular", specular, SPECULAR_MODELS)
+    _check_int("depth", depth)  # types here; ranges as the CLI's (_check_counts below)
+    _check_int("spp", spp)
+    if seed is None or _check_int("seed", seed, 0, MAX_SEED) is None:
+        raise ShadeLabError(f"seed={seed!r}: expected an integer in [0, 2**63 - 1]")
+    _check_bool("fresnel", fresnel)
+    _check_int("patches", patches, 1)
+    _check_choice("form_factors", form_factors, FORM_FACTORS)
+    _check_choice("solver", solver, RADIOSITY_SOLVERS)
+    _check_choice("backend", backend, BACKENDS)
+    if _check_int("workers", workers) is None:
+        raise ShadeLabError("workers=None: expected an integer in [1, 64]")
+    _check_bool("progress", progress, optional=False)
     chosen = pipelines.get(pipeline)
     accepts = set(getattr(chosen, "options", ()))
     if shading is not None and shading not in SHADING_MODES:
@@ -364,9 +457,12 @@ def probe(scene: Scene | str, pixel: tuple[int, int], size: Any = (800, 600),
     scene = _scene(scene)
     wh = _size(size, "raster")
     try:
-        x, y = (int(v) for v in pixel)
+        x, y = pixel
     except (TypeError, ValueError):
         raise ShadeLabError(f"pixel {pixel!r}: expected (x, y)") from None
+    if not (_is_int(x) and _is_int(y)):
+        raise ShadeLabError(f"pixel {pixel!r}: expected (x, y) integers")
+    x, y = int(x), int(y)
     if not (0 <= x < wh[0] and 0 <= y < wh[1]):
         raise ShadeLabError(f"pixel ({x}, {y}): outside the {wh[0]}x{wh[1]} image")
     if shading is not None and shading not in SHADING_MODES:
@@ -427,10 +523,14 @@ def show(scene: Scene | str, window: Any = (1600, 900), frames: int = 0,
     from shadelab.ui.display import NO_DISPLAY
 
     scene = _scene(scene)
+    _check_int("frames", frames, 0)
+    if frames is None:
+        raise ShadeLabError("frames=None: expected an integer >= 0")
+    _check_path("screenshot", screenshot, optional=True)
+    _check_bool("autosave", autosave, optional=False)
+    wh = _size(window, "raster")
     if not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
         raise ShadeLabError(NO_DISPLAY)
-    if frames < 0:
-        raise ShadeLabError(f"frames {frames}: expected a count >= 0")
     from shadelab.imageio import check_writable
 
     shot = str(screenshot) if screenshot else ""

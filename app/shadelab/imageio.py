@@ -16,7 +16,7 @@ import numpy as np
 from PIL import Image
 
 from shadelab.errors import ShadeLabError
-from shadelab.paths import OutputSet, output_problem, same_file
+from shadelab.paths import OutputSet, same_file
 from shadelab.shading.conventions import to_srgb8
 
 MAX_SIZE = 16384  # pixels per side
@@ -78,13 +78,12 @@ def cli_metadata(args: argparse.Namespace, **extra) -> dict[str, str]:
                           pipeline=pipeline, **extra)
 
 
-def check_writable(path: str | None, flag: str) -> None:
-    """Fail before any work if ``path`` cannot be written; nothing is created or changed."""
-    if not path:
-        return
-    problem = output_problem(path)
-    if problem:
-        raise ShadeLabError(f"{flag} '{path}': {problem}")
+def check_writable(path: str | None, flag: str, inputs=()) -> None:
+    """Fail before any work if ``path`` cannot be written, or would overwrite one of
+    ``inputs`` or a file shipped with ShadeLab; nothing is created or changed."""
+    from shadelab.paths import check_output
+
+    check_output(path or None, flag, inputs)
 
 
 def check_image_name(path: str | None, flag: str) -> None:
@@ -192,20 +191,23 @@ def save_outputs(args: argparse.Namespace, image: np.ndarray, exposure: float = 
             out.write("--npy", args.npy, _npy_writer(image))
 
 
-def check_outputs(args: argparse.Namespace) -> None:
-    """-o and --npy can be written, differ from each other and from the input preset."""
-    check_writable(args.output, "-o")
+def check_outputs(args: argparse.Namespace, scene=None) -> None:
+    """-o and --npy can be written, differ from each other and from every input: the preset,
+    the ``scene``'s meshes, textures and bump maps, and the files shipped with ShadeLab."""
+    from shadelab.paths import check_output
+
+    inputs = []
+    preset = getattr(args, "preset", None)
+    if preset or scene is not None:
+        from shadelab.scene.preset import resolve_preset, scene_inputs
+
+        if scene is not None:
+            inputs = scene_inputs(scene, preset)
+        else:
+            inputs = [("input preset", resolve_preset(preset))]
+    check_output(args.output, "-o", inputs)
     check_image_name(args.output, "-o")
-    check_writable(args.npy, "--npy")
+    check_output(args.npy, "--npy", inputs)
     if args.npy and (same_file(args.output, args.npy) or
                      Path(args.output).absolute() == Path(args.npy).absolute()):
         raise ShadeLabError(f"--npy '{args.npy}': the same file as -o; choose another name")
-    preset = getattr(args, "preset", None)
-    if preset:
-        from shadelab.scene.preset import resolve_preset
-
-        source = resolve_preset(preset)
-        for flag, path in (("-o", args.output), ("--npy", args.npy)):
-            if path and same_file(path, source):
-                raise ShadeLabError(f"{flag} '{path}': is the input preset; writing it would "
-                                    "destroy the preset; choose another name")

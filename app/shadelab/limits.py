@@ -22,6 +22,8 @@ MAX_SAMPLES = 2**28  # pixels x samples per pixel of one trace (~268 M, minutes 
 MAX_TRIANGLES = 4_000_000  # one scene, all objects (normals, BVH and GL buffers: ~1.5 GiB)
 MAX_OBJECTS = 10_000  # one scene (each is meshed, uploaded and drawn on its own)
 MAX_MESH_FILE_BYTES = 512 * 2**20  # a mesh file read whole by trimesh
+MAX_VERTEX_FACES = 4096  # triangles at one vertex of a mesh file (a polygon's fan, repeated
+#                          faces): smooth normals compare them pairwise, k x k
 MAX_PATCHES = 20_000  # radiosity: the N x N form-factor matrix is 3.2 GB of float64
 
 

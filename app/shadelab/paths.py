@@ -113,6 +113,59 @@ def same_file(a: str | Path, b: str | Path) -> bool:
         return False
 
 
+def _is_under(path: Path, folder: Path) -> bool:
+    try:
+        path.relative_to(folder)
+        return True
+    except ValueError:
+        return False
+
+
+def shipped_folders() -> list[Path]:
+    """The folders of files shipped with ShadeLab: the package, its presets and shaders."""
+    from shadelab.resources import presets_dir, shaders_dir
+
+    folders = [Path(__file__).resolve().parent]
+    for find in (presets_dir, shaders_dir):
+        try:
+            folders.append(find().resolve())
+        except FileNotFoundError:
+            pass
+    return folders
+
+
+def clobber_problem(path: str | Path, inputs=()) -> str | None:
+    """None if writing ``path`` destroys nothing the run reads or ShadeLab ships, else why:
+    ``inputs`` are (what, file) pairs (the preset, its meshes, textures, bump maps, a lesson);
+    a file shipped with ShadeLab (:func:`shipped_folders`) is never overwritten either."""
+    text = str(path)
+    if not text:
+        return None
+    target = Path(path)
+    for what, source in inputs:
+        if source and (same_file(target, source)
+                       or target.absolute() == Path(source).absolute()):
+            return f"is the {what} this run reads; writing it would destroy it; choose " \
+                "another name"
+    try:
+        real = resolve_link(target).resolve()
+    except (OSError, ShadeLabError, RuntimeError):
+        return None
+    if real.is_file() and any(_is_under(real, folder) for folder in shipped_folders()):
+        return "is a file shipped with ShadeLab; writing it would replace it; choose another name"
+    return None
+
+
+def check_output(path: str | Path | None, flag: str, inputs=()) -> None:
+    """The one guard of every writer: ``path`` can be written (:func:`output_problem`) and
+    is none of the run's inputs nor a shipped file (:func:`clobber_problem`); one line."""
+    if path is None or path == "":
+        return
+    problem = output_problem(path) or clobber_problem(path, inputs)
+    if problem:
+        raise ShadeLabError(f"{flag} '{path}': {problem}")
+
+
 class OutputSet:
     """Outputs of one run, written to temporary files and renamed only all together.
 

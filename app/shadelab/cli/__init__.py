@@ -32,6 +32,7 @@ COMMAND_MODULES = (
 )
 
 EXIT_BAD_INPUT = 2
+EXIT_IO_ERROR = 1      # an output could not be written
 
 
 class _Parser(argparse.ArgumentParser):
@@ -150,6 +151,11 @@ def main(argv: list[str] | None = None) -> int:
         except (OSError, ValueError):
             pass
         return 0
+    except OSError as exc:  # an output that could not be written (disk full, gone, denied)
+        name = f" '{exc.filename}'" if exc.filename else ""
+        print(f"shadelab: error:{name} {exc.strerror or type(exc).__name__}; nothing more "
+              "was written", file=sys.stderr)
+        return EXIT_IO_ERROR
     finally:
         progress.QUIET = saved_quiet
         if saved_term is not None:

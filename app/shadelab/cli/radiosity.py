@@ -43,7 +43,7 @@ def run_radiosity(args: argparse.Namespace) -> int:
         from shadelab.studies.autoquality import check_budget
 
         check_budget(args.error)
-    check_outputs(args)
+    check_outputs(args, scene)
     from shadelab.radiosity.solution import precheck
 
     if getattr(args, "error", None) is not None:

@@ -86,7 +86,7 @@ def run_raytrace(args: argparse.Namespace) -> int:
         from shadelab.studies.autoquality import check_budget
 
         check_budget(args.error)
-    check_outputs(args)
+    check_outputs(args, scene)
     from shadelab import pipelines
     from shadelab.progress import run_to_end
 
@@ -120,7 +120,7 @@ def run_pathtrace(args: argparse.Namespace) -> int:
 
     pathtrace = pipelines.get("pathtrace")
     pathtrace.check(scene, args.preset)
-    check_outputs(args)
+    check_outputs(args, scene)
     from shadelab.progress import run_to_end
 
     last = run_to_end(pathtrace.run(scene, size, args.spp, args.seed, args.backend,

@@ -85,7 +85,7 @@ def run_render(args: argparse.Namespace) -> int:
         from shadelab.studies.autoquality import check_budget
 
         check_budget(args.error)
-    check_outputs(args)
+    check_outputs(args, scene)
     from shadelab import pipelines  # GL (inside run) only once the input is known good
 
     if getattr(args, "error", None) is not None:
@@ -118,7 +118,7 @@ def run_pipeline(args: argparse.Namespace, pipeline, size: tuple[int, int]) -> i
     scene = load_preset(args.preset, list(args.set))
     pipeline.check(scene, args.preset)
     limits.check_pixels(size, bytes_per_pixel=64)
-    check_outputs(args)
+    check_outputs(args, scene)
     from shadelab.progress import run_to_end
 
     last = run_to_end(pipeline.run(scene, size), desc=pipeline.name)

@@ -35,6 +35,14 @@ def make_out_dir(text: str) -> Path:
         path.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise ShadeLabError(f"--out '{text}': cannot create folder ({exc.strerror})") from None
+    from shadelab.paths import _is_under, output_problem, shipped_folders
+
+    if any(_is_under(path.resolve(), folder) for folder in shipped_folders()):
+        raise ShadeLabError(f"--out '{text}': is a folder shipped with ShadeLab; its files "
+                            "would be replaced; choose another folder")
+    problem = output_problem(path / "index.md")  # a file can be made there (then removed)
+    if problem:
+        raise ShadeLabError(f"--out '{text}': {problem}")
     return path
 
 

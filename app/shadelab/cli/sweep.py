@@ -156,6 +156,18 @@ def run(args: argparse.Namespace) -> int:
         api.load_preset(args.preset, [*args.set, f"{key}={end}"])
     out = Path(args.output)
     kind = _output_kind(out)
+    from shadelab.imageio import check_writable
+    from shadelab.scene.preset import scene_inputs
+
+    inputs = scene_inputs(probe_scene, args.preset)
+    if kind == "png":  # a new folder (no input is one): can its parent take it?
+        from shadelab.paths import output_problem
+
+        problem = output_problem(out.resolve().parent / f".{out.name}-probe")
+        if problem:
+            raise ShadeLabError(f"-o '{out}': {problem}")
+    else:
+        check_writable(str(out), "-o", inputs)
     shadings = list(SHADING_MODES) if args.grid else [args.shading]
 
     def frame(value):

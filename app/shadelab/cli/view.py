@@ -11,6 +11,7 @@ from shadelab.scene.preset import scene_to_dict
 
 DEFAULT_PRESET = "lecture"
 DEFAULT_WINDOW = "1600x900"  # the window's size before it is maximized
+MAX_WINDOW = 16384           # a maximized window's side, at most (any monitor)
 from shadelab.ui.display import NO_DISPLAY, check_display  # noqa: E402,F401
 
 
@@ -84,6 +85,45 @@ def _pixel(text: str, flag: str) -> tuple[int, int]:
     if x < 0 or y < 0:
         raise ShadeLabError(f"{flag} '{text}': expected non-negative pixel coordinates")
     return x, y
+
+
+from shadelab.lab.panel_names import PANEL_LABELS, unknown_panel  # noqa: E402
+
+RAY_TREE_HEIGHT = 256    # the offline image's height (OfflineState.size) --ray-tree points in
+RAY_TREE_MAX_ASPECT = 4  # its width: the viewport's aspect times that, at most this times it
+
+
+def check_focus(focus: str) -> None:
+    """--focus names dock windows by a label prefix or a word of one (ui.layout.focus_windows)."""
+    word = unknown_panel(focus)
+    if word is not None:
+        raise ShadeLabError(f"--focus '{focus}': no panel '{word}'; expected one of "
+                            f"{', '.join(PANEL_LABELS)}")
+
+
+def _check_pixels(args: argparse.Namespace, window: tuple[int, int]):
+    """(probe, ray_tree) pixels, each inside what it points in: the viewport (within the
+    window) and the --job whitted image."""
+    probe = _pixel(args.probe, "--probe") if args.probe else None
+    if probe is not None:
+        limit = window if args.window else (MAX_WINDOW, MAX_WINDOW)  # maximized: any monitor
+        if probe[0] >= limit[0] or probe[1] >= limit[1]:
+            where = f"the {limit[0]}x{limit[1]} window" if args.window \
+                else f"any window (x, y < {MAX_WINDOW})"
+            raise ShadeLabError(f"--probe '{args.probe}': outside {where}; expected a pixel "
+                                "of the viewport")
+    ray_tree = _pixel(args.ray_tree, "--ray-tree") if args.ray_tree else None
+    if ray_tree is not None:
+        from shadelab.lab.jobs import find_job
+
+        kind = find_job(args.job) if args.job else None
+        if kind is None or getattr(kind, "pipeline", "") != "raytrace":
+            raise ShadeLabError(f"--ray-tree '{args.ray_tree}': only with --job whitted")
+        if ray_tree[1] >= RAY_TREE_HEIGHT or \
+                ray_tree[0] >= RAY_TREE_HEIGHT * RAY_TREE_MAX_ASPECT:
+            raise ShadeLabError(f"--ray-tree '{args.ray_tree}': outside the job's image "
+                                f"({RAY_TREE_HEIGHT} pixels high)")
+    return probe, ray_tree
 
 
 def _check_study_and_case(args: argparse.Namespace) -> None:
@@ -168,8 +208,9 @@ def run_view(args: argparse.Namespace) -> int:
                             "in .png")
     if args.job is not None:
         check_job(args.job)
-    probe = _pixel(args.probe, "--probe") if args.probe else None
-    ray_tree = _pixel(args.ray_tree, "--ray-tree") if args.ray_tree else None
+    probe, ray_tree = _check_pixels(args, window)
+    if args.focus is not None:
+        check_focus(args.focus)
     if args.frames < 0:
         raise ShadeLabError(f"--frames {args.frames}: expected a count >= 0")
     _check_study_and_case(args)
@@ -201,6 +242,15 @@ def run_view(args: argparse.Namespace) -> int:
         scene, source, restored = _restored_meshes_or_preset(args, scene, source, notes)
     else:
         scene_meshes(scene)  # a broken mesh file fails here, with its one-line reason
+    if args.screenshot:  # not one of the scene's own files either
+        from shadelab.scene.preset import scene_inputs
+
+        inputs = scene_inputs(scene, source)
+        if args.lesson:
+            from shadelab.lab.lesson_file import resolve_lesson
+
+            inputs.append(("lesson", resolve_lesson(args.lesson)))
+        check_writable(args.screenshot, "--screenshot", inputs)
     exercise = None
     if args.exercise:
         from shadelab.exercises import load_exercise

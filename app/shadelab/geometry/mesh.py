@@ -407,6 +407,7 @@ def read_mesh(path: str, base_dir: str, key: str, weld: bool = True) -> LoadedMe
     if weld:
         vertices, faces, uvs, places = weld_vertices(vertices, faces, uvs)
     faces, dropped = drop_degenerate(vertices, faces, places)
+    check_fans(faces, places, f"{key}: '{name}'")
     if len(faces) == 0:
         raise ShadeLabError(f"{key}: '{name}' has only degenerate (zero-area) triangles "
                             f"({dropped} of them): nothing to draw")
@@ -414,6 +415,22 @@ def read_mesh(path: str, base_dir: str, key: str, weld: bool = True) -> LoadedMe
         note(f"{key}: '{name}': dropped {dropped} degenerate (zero-area) "
              f"triangle{'s' if dropped != 1 else ''} of {dropped + len(faces)}")
     return LoadedMesh(vertices, faces, uvs, places, dropped)
+
+
+def check_fans(faces: np.ndarray, places: np.ndarray | None, where: str) -> None:
+    """The triangles around one vertex stay within limits.MAX_VERTEX_FACES: a polygon of
+    100,000 vertices (fanned into triangles from one corner) or one face repeated 300,000
+    times would ask the normals for a k x k comparison (74 GiB, 671 GiB)."""
+    if len(faces) == 0:
+        return
+    at = places[faces] if places is not None else faces
+    counts = np.bincount(at.reshape(-1))
+    vertex = int(counts.argmax())
+    k = int(counts[vertex])
+    what = f"{where}: vertex {vertex} is a corner of {k:,} triangles (a huge polygon's fan " \
+        "or repeated faces)"
+    limits.check(what, k, limits.MAX_VERTEX_FACES, " triangles at a vertex")  # the budget
+    limits.check(what, k, float("inf"), " triangles at a vertex", memory_bytes=9.0 * k * k)
 
 
 TRIANGLE_BAR_MIN = 200_000  # a mesh this large shows a bar (in triangles) on a terminal

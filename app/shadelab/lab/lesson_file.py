@@ -101,13 +101,17 @@ def load_lesson(name_or_path: str, check: bool = True) -> Lesson:
         if bad:
             raise ShadeLabError(f"{where}: steps[{i}]: show: unknown '{bad[0]}' "
                                 f"(expected {', '.join(SHOW_TOGGLES)})")
+        _check_pipeline_and_focus(where, i, item)
         preset = item["preset"]
         if not Path(preset).is_absolute() and preset.endswith(".toml"):
             preset = str(path.parent / preset)  # a preset file next to the lesson
         steps.append(Step(item["title"], item["caption"], preset, list(overrides),
                           str(item.get("pipeline", "")), str(item.get("focus", "")),
                           list(show)))
-    lesson = Lesson(str(raw.get("name", path.stem)), steps, str(path))
+    name = raw.get("name", path.stem)
+    if not isinstance(name, str) or not name.strip():
+        raise ShadeLabError(f"{where}: key 'name': expected a non-empty string")
+    lesson = Lesson(name, steps, str(path))
     if check:
         for i, step in enumerate(lesson.steps):
             try:
@@ -115,6 +119,29 @@ def load_lesson(name_or_path: str, check: bool = True) -> Lesson:
             except ShadeLabError as exc:
                 raise ShadeLabError(f"{where}: steps[{i}] ('{step.title}'): {exc}") from None
     return lesson
+
+
+def _check_pipeline_and_focus(where: str, i: int, item: dict) -> None:
+    """A step's ``pipeline`` is one of shadelab.pipelines.names(); its ``focus`` names
+    panels; both are strings (one line naming the step and the key otherwise)."""
+    from shadelab import pipelines
+    from shadelab.lab.panel_names import PANEL_LABELS, unknown_panel
+
+    title = item.get("title", "")
+    step = f"{where}: steps[{i}] ('{title}')"
+    for key in ("pipeline", "focus"):
+        if key in item and not isinstance(item[key], str):
+            raise ShadeLabError(f"{step}: key '{key}': expected a string, got "
+                                f"{type(item[key]).__name__} {item[key]!r}")
+    pipeline = item.get("pipeline", "")
+    if pipeline and pipeline not in pipelines.names():
+        raise ShadeLabError(f"{step}: key 'pipeline': unknown '{pipeline}' (expected one of "
+                            f"{', '.join(pipelines.names())})")
+    focus = item.get("focus", "")
+    word = unknown_panel(focus) if focus else None
+    if word is not None:
+        raise ShadeLabError(f"{step}: key 'focus': no panel '{word}' (expected one of "
+                            f"{', '.join(PANEL_LABELS)})")
 
 
 def step_scene(step: Step) -> Scene:

@@ -12,6 +12,7 @@ texture or a bump, so every other material keeps its exact output.
 from __future__ import annotations
 
 import moderngl
+import numpy as np
 
 from shadelab.gl.programs import set_uniform
 from shadelab.scene.model import Material
@@ -29,6 +30,28 @@ from shadelab.shading.surface_detail import (  # noqa: F401  (re-exported, the p
 )
 
 
+def fit_texture(pixels: np.ndarray, limit: int, key: str = "texture") -> np.ndarray:
+    """The image as a GL texture can hold it: a side over ``limit`` (GL_MAX_TEXTURE_SIZE;
+    a larger one is GL_INVALID_VALUE and draws black) is box-filtered down, the aspect kept,
+    with a one-line note. The CPU renderers sample the full image."""
+    h, w = pixels.shape[:2]
+    if max(w, h) <= limit:
+        return pixels
+    from PIL import Image
+
+    scale = limit / max(w, h)
+    size = (min(max(int(round(w * scale)), 1), limit), min(max(int(round(h * scale)), 1), limit))
+    channels = pixels[..., None] if pixels.ndim == 2 else pixels
+    out = np.stack([np.asarray(Image.fromarray(np.ascontiguousarray(channels[..., c]), "F")
+                               .resize(size, Image.Resampling.BOX), dtype=np.float32)
+                    for c in range(channels.shape[2])], axis=-1)
+    from shadelab.progress import note
+
+    note(f"{key}: {w}x{h} image resampled to {size[0]}x{size[1]} for the raster "
+         f"(GL_MAX_TEXTURE_SIZE {limit})")
+    return np.ascontiguousarray(out[..., 0] if pixels.ndim == 2 else out)
+
+
 class TextureCache:
     """GPU textures for image files, keyed by resolved path and kind; made on first use."""
 
@@ -39,7 +62,8 @@ class TextureCache:
     def get(self, path: str, base_dir: str, key: str, height: bool) -> moderngl.Texture:
         slot = (path, base_dir, height)
         if slot not in self._textures:
-            pixels = load_image(path, base_dir, key, height)
+            pixels = fit_texture(load_image(path, base_dir, key, height),
+                                 int(self.ctx.info.get("GL_MAX_TEXTURE_SIZE", 4096)), key)
             h, w = pixels.shape[:2]
             texture = self.ctx.texture((w, h), 1 if height else 3, pixels.tobytes(), dtype="f4")
             texture.repeat_x = texture.repeat_y = True

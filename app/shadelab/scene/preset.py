@@ -19,7 +19,13 @@ import tomli_w
 
 from shadelab import limits
 from shadelab.errors import ShadeLabError
-from shadelab.paths import OutputSet, file_problem, output_problem, resolve_link
+from shadelab.paths import (
+    OutputSet,
+    clobber_problem,
+    file_problem,
+    output_problem,
+    resolve_link,
+)
 from shadelab.progress import steps
 from shadelab.resources import presets_dir
 from shadelab.scene.model import (
@@ -89,6 +95,34 @@ def load_preset(name_or_path: str, overrides: list[str] | None = None) -> Scene:
     adopt_obj_materials(scene, {name: set(t) for name, t in tables.items()
                                 if isinstance(t, dict)}, str(path))
     return scene
+
+
+def scene_inputs(scene: Scene, preset: str | Path | None = None) -> list[tuple[str, Path]]:
+    """(what, file) of every file a scene was read from: its preset (a name or a path), mesh,
+    texture and bump files (what :func:`shadelab.paths.check_output` keeps from being
+    overwritten)."""
+    files: list[tuple[str, Path]] = []
+    if preset:
+        try:
+            files.append(("input preset", resolve_preset(str(preset))))
+        except ShadeLabError:
+            pass
+    base = Path(scene.base_dir)
+
+    def add(what: str, value: str) -> None:
+        files.append((what, Path(value) if Path(value).is_absolute() else base / value))
+    for obj in scene.objects:
+        if obj.shape == "mesh" and obj.path:
+            add("mesh", obj.path)
+            if Path(obj.path).suffix.lower() == ".obj":  # its MTL and the MTL's textures
+                mtl = (Path(obj.path) if Path(obj.path).is_absolute() else base / obj.path)
+                files.extend(("mesh", p) for p in mtl.parent.glob("*.mtl"))
+    for m in scene.materials.values():
+        if m.texture and m.texture != "checker":
+            add("texture", m.texture)
+        if m.bump and m.bump != "bumps":
+            add("bump map", m.bump)
+    return files
 
 
 def check_files(scene: Scene, source: str) -> None:
@@ -445,7 +479,7 @@ def save_preset(scene: Scene, path: str | Path) -> None:
     shared target changes, the link stays). Relative mesh and image paths are rebased on the
     new folder, so the saved preset finds the same files."""
     path = Path(path)
-    problem = output_problem(path)
+    problem = output_problem(path) or clobber_problem(path, scene_inputs(scene))
     if problem:
         raise ShadeLabError(f"{path}: cannot write the preset: {problem}")
     text = tomli_w.dumps(_rebased(scene_to_dict(scene), Path(scene.base_dir),

@@ -33,6 +33,7 @@ from shadelab.ui import (
     lights_panel,
     materials_panel,
     objects_panel,
+    offline,
     panels,
     pipeline_viewport,
     pipelines,
@@ -371,6 +372,7 @@ class Viewer:
         """Before any panel draws: the GPU work and images the panels queued last frame."""
         if self.gpu is not None:
             guarded(lambda: self.gpu.flush(self.state.gpu), "GPU requests", self.report_error)
+            guarded(lambda: offline.update(self.state), "offline job", self.report_error)
         gizmos.begin_frame()
 
     def panel(self, draw: Callable[[AppState], bool]) -> Callable[[], None]:

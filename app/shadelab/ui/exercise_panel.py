@@ -9,6 +9,7 @@ window stays readable in a 1024x768 presenter layout.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -240,7 +241,7 @@ def _draw_answer(state, panel: ExercisePanel, task, ts: TaskState, width: float)
         values = list(ts.answer) if ts.answer is not None else list(task.start)
         for i, (key, (lo, hi)) in enumerate(zip(task.params, task.ranges, strict=True)):
             changed, v = imgui.slider_float(key, float(values[i]), lo, hi)
-            if changed:
+            if changed and math.isfinite(v):  # a typed nan / inf is refused
                 values[i] = float(v)
         ts.answer = values
         target = task.target_shot()

@@ -9,6 +9,8 @@ that roll-back so it does not raise in its turn.
 
 from __future__ import annotations
 
+import os
+import sys
 import traceback
 from typing import Callable
 
@@ -46,5 +48,19 @@ def guarded(draw: Callable[[], object], where: str, report: Callable[[str], None
             io.config_error_recovery_enable_tooltip = tooltip_before
         message = error_message(where, exc)
         report(message)
-        traceback.print_exception(exc)  # the whole story stays on the terminal
+        _tell(message, exc)
         return default
+
+
+_told: list[str] = []   # the last message written to stderr (one line, not once per frame)
+
+
+def _tell(message: str, exc: BaseException) -> None:
+    """One line on stderr per new error, no traceback (the status line shows it too); the
+    whole story with SHADELAB_DEBUG=1."""
+    if os.environ.get("SHADELAB_DEBUG"):
+        traceback.print_exception(exc)
+        return
+    if _told[-1:] != [message]:
+        _told[:] = [message]
+        print(f"shadelab: {message}", file=sys.stderr)

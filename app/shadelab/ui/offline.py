@@ -93,6 +93,16 @@ def _job_size(state: AppState) -> tuple[int, int]:
     return max(int(round(height * w / max(h, 1))), 1), height
 
 
+def update(state: AppState) -> None:
+    """Once a frame, whichever panel is visible: collect the job's latest image (a job started
+    with the Offline panel hidden, by --job or the Studies panel, still ends)."""
+    if not state.gpu.attached:
+        return
+    _upload_results(state)
+    if "job_raster" in state.gpu.errors:
+        state.error = f"raster view to compare with: {state.gpu.errors.pop('job_raster')}"
+
+
 def _upload_results(state: AppState) -> None:
     """Re-upload the job's image, its raster partner and their difference when new."""
     raster = state.gpu.take("job_raster")
@@ -267,9 +277,6 @@ def draw_offline_panel(state: AppState) -> bool:
         imgui.pop_text_wrap_pos()
     if not state.gpu.attached:
         return False
-    _upload_results(state)
-    if "job_raster" in state.gpu.errors:
-        state.error = f"raster view to compare with: {state.gpu.errors.pop('job_raster')}"
     width = (imgui.get_content_region_avail().x - 16) / 3
     if state.gpu.texture("job_result") is not None and width > 8:
         ray_tree = kind.pipeline == "raytrace"  # the Whitted tracer keeps a ray tree per pixel

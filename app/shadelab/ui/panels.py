@@ -14,7 +14,7 @@ from imgui_bundle import imgui
 
 from shadelab.lab.state import AppState
 from shadelab.shading.conventions import linear_to_srgb, srgb_to_linear
-from shadelab.ui.ranges import intensity_range
+from shadelab.ui.ranges import finite, intensity_range
 
 ERROR_COLOR = imgui.ImVec4(1.0, 0.35, 0.3, 1.0)
 DIM_COLOR = imgui.ImVec4(0.65, 0.65, 0.65, 1.0)
@@ -45,9 +45,13 @@ def stored_color(shown) -> tuple[float, float, float]:
 
 def rgb_color(label: str, value) -> tuple[bool, tuple[float, float, float]]:
     """A colour picker on a linear RGB value (presets and the equation are linear): it shows
-    and edits the colour as it appears on screen; an untouched value is returned as it was."""
+    and edits the colour as it appears on screen; an untouched value is returned as it was,
+    a typed nan, inf or 1e309 is refused (the old value kept)."""
     changed, rgb = imgui.color_edit3(label, list(shown_color(value)),
                                      imgui.ColorEditFlags_.float)
+    if not changed:
+        return False, tuple(float(c) for c in value)
+    changed, rgb = finite(changed, tuple(float(c) for c in rgb), None)
     if not changed:
         return False, tuple(float(c) for c in value)
     return True, stored_color(rgb)
@@ -60,8 +64,8 @@ def intensity_color(label: str, value) -> tuple[bool, tuple[float, float, float]
     color = rgb / scale if scale > 0 else np.ones(3)
     imgui.push_id(label)
     changed_c, color = rgb_color(f"{label} color", tuple(color))
-    changed_s, scale = imgui.slider_float(f"{label} intensity", scale, 0.0,
-                                          intensity_range(scale), "%.4g")
+    changed_s, scale = finite(*imgui.slider_float(f"{label} intensity", scale, 0.0,
+                                                  intensity_range(scale), "%.4g"), scale)
     imgui.pop_id()
     if changed_c or changed_s:
         return True, tuple(float(c) * scale for c in color)
@@ -71,12 +75,12 @@ def intensity_color(label: str, value) -> tuple[bool, tuple[float, float, float]
 def slider(label: str, value: float, lo: float, hi: float, log: bool = False,
             fmt: str = "%.3f") -> tuple[bool, float]:
     flags = imgui.SliderFlags_.logarithmic if log else 0
-    return imgui.slider_float(label, float(value), lo, hi, fmt, flags)
+    return finite(*imgui.slider_float(label, float(value), lo, hi, fmt, flags), value)
 
 
 def vec3(label: str, value, speed: float) -> tuple[bool, tuple[float, float, float]]:
     changed, v = imgui.drag_float3(label, list(value), speed, 0.0, 0.0, "%.3g")
-    return changed, tuple(float(c) for c in v)
+    return finite(changed, tuple(float(c) for c in v), tuple(value))
 
 
 def edit_fields(obj, rows: list[tuple]) -> bool:

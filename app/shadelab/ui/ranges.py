@@ -74,9 +74,20 @@ def field_slider(cls: type):
         lo, hi, log, fmt = slider_range(cls, label, float(value))
         flags = imgui.SliderFlags_.logarithmic if log else 0
         changed, new = imgui.slider_float(label, float(value), lo, hi, fmt, flags)
+        if not math.isfinite(new):  # typed nan, inf or 1e309: the value is kept
+            return False, value
         spec_lo, spec_hi = spec_range(cls, label)
         return changed, float(min(max(new, spec_lo), spec_hi))
     return widget
+
+
+def finite(changed: bool, new, old) -> tuple[bool, object]:
+    """A widget's (changed, value), with a typed nan, inf or 1e309 (in any component) refused:
+    the old value is kept and nothing changed."""
+    values = new if isinstance(new, (tuple, list)) else (new,)
+    if all(math.isfinite(float(v)) for v in values):
+        return changed, new
+    return False, old
 
 
 def intensity_range(value: float, soft_hi: float = 2.0, hi: float = 1e12) -> float:

@@ -9,6 +9,7 @@ shows the reason underneath and the scene keeps its value.
 
 from __future__ import annotations
 
+import math
 from dataclasses import fields
 
 from imgui_bundle import imgui
@@ -79,7 +80,10 @@ def float_slider(label: str, obj, name: str, lo: float | None = None, hi: float 
         lo, hi, log = soft_lo if lo is None else lo, soft_hi if hi is None else hi, \
             log or soft_log
     flags = imgui.SliderFlags_.always_clamp | (imgui.SliderFlags_.logarithmic if log else 0)
-    changed, value = imgui.slider_float(label, float(getattr(obj, name)), lo, hi, fmt, flags)
+    old = float(getattr(obj, name))
+    changed, value = imgui.slider_float(label, old, lo, hi, fmt, flags)
+    if changed and not math.isfinite(value):  # typed nan, inf or 1e309: the value is kept
+        changed = False
     if changed:
         setattr(obj, name, float(min(max(value, spec_lo), spec_hi)))
     return changed
