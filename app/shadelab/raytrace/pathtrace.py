@@ -56,6 +56,7 @@ from shadelab.progress import Progress
 from shadelab.raytrace import glossy, surface_rays, vertex
 from shadelab.raytrace import rays as ray_kernels
 from shadelab.raytrace.accel import Hits, embree_available
+from shadelab.raytrace.sampler import SAMPLERS, SobolSampler
 from shadelab.raytrace.surface import TraceContext, reflect_refract
 from shadelab.raytrace.whitted import stratified_jitter
 from shadelab.scene.model import Scene
@@ -199,11 +200,13 @@ class PathTracer:
         self.rays = 0  # counter of rays cast (paths and shadow rays)
         self.primary_hits = 0  # counter of camera rays that hit something
 
-    def radiance(self, origins: np.ndarray, dirs: np.ndarray,
-                 rng: np.random.Generator) -> np.ndarray:
-        """One-sample estimates of L (N, 3) along N camera rays."""
+    def radiance(self, origins: np.ndarray, dirs: np.ndarray, rng: np.random.Generator,
+                 sampler: SobolSampler | None = None) -> np.ndarray:
+        """One-sample estimates of L (N, 3) along N camera rays: the vertices' uniforms
+        from ``sampler`` (Sobol', ray i being the sampler's pixel i) or, without one, from
+        ``rng`` (independent; the numpy implementation always draws from ``rng``)."""
         if self.ctx.kernels:
-            return self._radiance_kernel(origins, dirs, rng)
+            return self._radiance_kernel(origins, dirs, rng, sampler)
         n = len(origins)
         out = np.zeros((n, 3))
         beta = np.ones((n, 3))
@@ -240,7 +243,8 @@ class PathTracer:
         return out
 
     def _radiance_kernel(self, origins: np.ndarray, dirs: np.ndarray,
-                         rng: np.random.Generator) -> np.ndarray:
+                         rng: np.random.Generator,
+                         sampler: SobolSampler | None = None) -> np.ndarray:
         """:meth:`radiance` with each path vertex in one numba call (same estimator,
         :func:`shadelab.raytrace.vertex.path_vertex`)."""
         ctx, n, em = self.ctx, len(origins), self.emitters
@@ -258,12 +262,14 @@ class PathTracer:
                 ray_kernels.add_rows(out, pixel, beta * self._delta_lights(surf, d, mat, textured),
                                  np.ones(len(pixel), np.bool_))
             mat, tables, lobes = self._textured_tables(mat, textured)
+            rnd = (rng.random((len(t), 7)) if sampler is None
+                   else sampler.vertex(pixel, bounce, em.cdf))
             (nee_o, nee_d, nee_t, nee_ok, nee_val, o, d, beta, bsdf_pdf,
              alive) = vertex.path_vertex(
                 out, pixel, beta, bsdf_pdf, surf.position, surf.normal, surf.geo_normal,
                 surf.entering, np.ascontiguousarray(d), t, mat, tables, lobes,
                 (em.cdf, em.p0, em.e1, em.e2, em.normal, em.le, float(em.total_area)),
-                ctx.eps, rng.random((len(t), 7)), bounce >= RR_START, self.blinn)
+                ctx.eps, rnd, bounce >= RR_START, self.blinn)
             cand = np.flatnonzero(nee_ok)
             if len(cand):
                 blocked = ctx.accel.occluded(nee_o[cand], nee_d[cand], nee_t[cand],
@@ -483,14 +489,22 @@ def _add(out: np.ndarray, pixel: np.ndarray, value: np.ndarray) -> None:
 
 def iter_pathtrace(scene: Scene, size: tuple[int, int], spp: int, seed: int = 0,
                    backend: str = "auto", local: str = "numba",
-                   workers: int = 1) -> Iterator[Progress]:
+                   workers: int = 1, sampler: str | None = None) -> Iterator[Progress]:
     """Path-trace progressively: one :class:`Progress` per tile of rows per sample pass.
 
     The image in each Progress is the mean over the samples each pixel has so far
     (radiance, float32, row 0 at the top); stats hold samples/s and rays/s. Each tile of
     each pass draws from its own random stream (``seed``, pass, first row), so the image
     is the same for any number of ``workers`` (processes; 1 traces here).
+
+    ``sampler`` (default: the scene's ``raytrace.sampler``) is ``"sobol"``, Owen-scrambled
+    Sobol' per pixel (:mod:`shadelab.raytrace.sampler`; sample pass s is each pixel's
+    Sobol' index s, so power-of-two sample counts stratify best), or ``"independent"``
+    uniforms from each tile's stream.
     """
+    sampler = scene.raytrace.sampler if sampler is None else sampler
+    if sampler not in SAMPLERS:
+        raise ShadeLabError(f"sampler {sampler!r}: expected one of {', '.join(SAMPLERS)}")
     width, height = size
     if width < 1 or height < 1:
         raise ShadeLabError(f"--size {width}x{height}: expected each side >= 1")
@@ -499,7 +513,7 @@ def iter_pathtrace(scene: Scene, size: tuple[int, int], spp: int, seed: int = 0,
     rows = max(1, TILE_PATHS // width)
     tiles = [(r, min(r + rows, height)) for r in range(0, height, rows)]
     jobs = [(sample, r0, r1) for sample in range(spp) for r0, r1 in tiles]
-    setup = (scene, size, spp, seed, backend, local)
+    setup = (scene, size, spp, seed, backend, local, sampler)
     if workers > 1 and len(jobs) > 1:
         from shadelab.raytrace.pool import traced_in_pool
 
@@ -538,14 +552,14 @@ class TileJob:
     """Traces tile (pass, r0, r1): its jittered camera rays and one path per pixel."""
 
     def __init__(self, scene: Scene, size: tuple[int, int], spp: int, seed: int,
-                 backend: str, local: str):
+                 backend: str, local: str, sampler: str = "sobol"):
         from shadelab.scene.camera import (  # the camera's own frame, so the images align
             camera_basis,
             tan_half_fov_y,
         )
 
         self.tracer = PathTracer(scene, backend, local=local)
-        self.size, self.spp, self.seed = size, spp, seed
+        self.size, self.spp, self.seed, self.sampler = size, spp, seed, sampler
         cam = scene.camera
         self.frame = camera_basis(cam)
         self.eye = np.asarray(cam.eye, dtype=np.float64)
@@ -555,14 +569,18 @@ class TileJob:
         """(radiance (n, 3), rays cast, primary hits) of one tile."""
         width, height = self.size
         rng = np.random.default_rng([self.seed, sample, r0])
-        # Stratified pixel positions: sample s jitters inside stratum s
-        jitter = (rng.random((r1 - r0, width, 2)) if self.spp == 1
-                  else stratified_jitter(self.spp, sample, (r1 - r0, width), rng))
+        sobol = None
+        if self.sampler == "sobol":  # pixel positions: each pixel's Sobol' pair 0
+            sobol = SobolSampler(self.seed, sample, r0 * width)
+            jitter = sobol.jitter((r1 - r0) * width).reshape(r1 - r0, width, 2)
+        else:  # stratified pixel positions: sample s jitters inside stratum s
+            jitter = (rng.random((r1 - r0, width, 2)) if self.spp == 1
+                      else stratified_jitter(self.spp, sample, (r1 - r0, width), rng))
         forward, right, up = self.frame
         o, d = ray_kernels.camera_rays(self.eye, forward, right, up, self.tan_half, width, height,
                                    r0, r1, jitter)
         before_rays, before_hits = self.tracer.rays, self.tracer.primary_hits
-        radiance = self.tracer.radiance(o, d, rng)
+        radiance = self.tracer.radiance(o, d, rng, sobol)
         return (radiance, self.tracer.rays - before_rays,
                 self.tracer.primary_hits - before_hits)
 
@@ -580,13 +598,14 @@ def _trace_tile(sample: int, r0: int, r1: int):
 
 
 def render_pathtraced(scene: Scene, size: tuple[int, int], spp: int, seed: int = 0,
-                      workers: int = 1) -> np.ndarray:
+                      workers: int = 1, sampler: str | None = None) -> np.ndarray:
     """Path-traced radiance (H, W, 3) float32, row 0 at the top (Embree where available).
 
     ``workers`` > 1 traces tiles in that many processes (same image; worth it from about
-    a million samples, each worker takes a second or two to start).
+    a million samples, each worker takes a second or two to start); ``sampler`` as in
+    :func:`iter_pathtrace`.
     """
     last = None
-    for step in iter_pathtrace(scene, size, spp, seed, workers=workers):
+    for step in iter_pathtrace(scene, size, spp, seed, workers=workers, sampler=sampler):
         last = step
     return last.image
