@@ -17,6 +17,11 @@ from shadelab.scene.preset import load_preset
 SEEDS = 48
 
 
+def _at(index: int, pixels: np.ndarray) -> np.ndarray:
+    """Sample ``index`` for every pixel."""
+    return np.full(len(pixels), index, np.int64)
+
+
 def _is_net(points: np.ndarray) -> bool:
     """2^m points in [0, 1)^2 form a (0, m, 2)-net: one point in every 2^a x 2^(m-a) box."""
     m = int(round(math.log2(len(points))))
@@ -31,14 +36,14 @@ def _is_net(points: np.ndarray) -> bool:
 @pytest.mark.parametrize("pair", [0, 1, 5, 17])
 def test_every_power_of_two_prefix_of_a_pixel_is_a_net(pair):
     pixels = np.array([0, 1, 12345, 2 ** 40 + 7], np.int64)
-    points = np.stack([sampler.sobol_pairs(9, pixels, pair, i) for i in range(256)])
+    points = np.stack([sampler.sobol_pairs(9, pixels, pair, _at(i, pixels)) for i in range(256)])
     assert points.min() >= 0.0 and points.max() < 1.0
     for p in range(len(pixels)):
         for n in (1, 2, 4, 16, 64, 256):
             assert _is_net(points[:n, p]), (p, n)
     # pixels and pairs are scrambled apart, seeds too
     assert not np.allclose(points[:, 0], points[:, 1])
-    other = np.stack([sampler.sobol_pairs(10, pixels, pair, i) for i in range(4)])
+    other = np.stack([sampler.sobol_pairs(10, pixels, pair, _at(i, pixels)) for i in range(4)])
     assert not np.allclose(points[:4], other)
 
 
@@ -78,7 +83,7 @@ def _rms_errors(estimate, exact: float, n: int, bounce: int) -> tuple[float, flo
     pixel = np.array([77], np.int64)
     sobol, indep = [], []
     for seed in range(SEEDS):
-        u = np.concatenate([sampler.vertex_uniforms(seed, pixel, i, bounce, _CDF)
+        u = np.concatenate([sampler.vertex_uniforms(seed, pixel, _at(i, pixel), bounce, _CDF)
                             for i in range(n)])
         sobol.append(estimate(u) - exact)
         indep.append(estimate(np.random.default_rng(seed).random((n, 7))) - exact)
@@ -107,7 +112,8 @@ def test_bsdf_directions_converge_faster_than_independent(n, ratio):
 def test_the_triangle_choice_keeps_the_barycentric_variable_uniform():
     """u1 is u0 re-scaled inside its triangle's stretch of the CDF: uniform in [0, 1)."""
     cdf = np.array([0.2, 0.3, 1.0])
-    u = np.concatenate([sampler.vertex_uniforms(4, np.arange(64, dtype=np.int64), i, 0, cdf)
+    pixels = np.arange(64, dtype=np.int64)
+    u = np.concatenate([sampler.vertex_uniforms(4, pixels, _at(i, pixels), 0, cdf)
                         for i in range(64)])
     assert u.min() >= 0.0 and u.max() < 1.0
     assert abs(u[:, 1].mean() - 0.5) < 0.01
@@ -132,3 +138,20 @@ def test_path_tracer_sampler_option():
     np.testing.assert_array_equal(render_pathtraced(indep, (12, 12), 4, seed=5), b)
     with pytest.raises(ShadeLabError, match="sampler 'halton'"):
         render_pathtraced(scene, (4, 4), 1, sampler="halton")
+
+
+def test_passes_in_one_wavefront_trace_what_they_trace_one_by_one():
+    """A small image traces several passes per job (``passes_per_job``): with Sobol' each
+    path draws by (pixel, sample index), so four passes in one wavefront sum to exactly
+    the four passes traced apart (to rounding), and the jobs cover every pass once."""
+    from shadelab.raytrace.pathtrace import TileJob, passes_per_job
+
+    scene = load_preset("cornell")
+    size = (16, 12)
+    job = TileJob(scene, size, 8, 3, "auto", "numba", "sobol")
+    together, _, hits = job(4, 0, 12, 4)
+    apart = [job(s, 0, 12) for s in range(4, 8)]
+    np.testing.assert_allclose(together, sum(a[0] for a in apart), rtol=1e-9, atol=1e-12)
+    assert hits == apart[0][2] > 0
+    assert passes_per_job(size, 64) == 16 and passes_per_job(size, 3) == 1
+    assert passes_per_job((512, 512), 64) == 1

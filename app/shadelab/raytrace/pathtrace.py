@@ -63,7 +63,8 @@ from shadelab.scene.model import Scene
 from shadelab.shading import kernels as shading_kernels
 from shadelab.shading import packing
 
-TILE_PATHS = 16384    # paths per work unit (one chunk of the generator)
+TILE_PATHS = 16384    # paths per work unit (one chunk of the generator); small images
+                      # trace several sample passes in one unit (one wavefront)
 MAX_BOUNCES = 64      # hard cap; Russian roulette ends paths long before
 RR_START = 3          # bounces before Russian roulette starts
 
@@ -199,11 +200,16 @@ class PathTracer:
         self.direct_materials[:, packing.M_LE:packing.M_LE + 3] = 0.0
         self.rays = 0  # counter of rays cast (paths and shadow rays)
         self.primary_hits = 0  # counter of camera rays that hit something
+        self._hit_rows = np.zeros(0, bool)  # the last batch's camera rays that hit
+
+    def first_hits(self, n: int) -> int:
+        """Of the last :meth:`radiance` batch's first ``n`` camera rays, how many hit."""
+        return int(np.count_nonzero(self._hit_rows[:n]))
 
     def radiance(self, origins: np.ndarray, dirs: np.ndarray, rng: np.random.Generator,
                  sampler: SobolSampler | None = None) -> np.ndarray:
         """One-sample estimates of L (N, 3) along N camera rays: the vertices' uniforms
-        from ``sampler`` (Sobol', ray i being the sampler's pixel i) or, without one, from
+        from ``sampler`` (Sobol', ray i being the sampler's path i) or, without one, from
         ``rng`` (independent; the numpy implementation always draws from ``rng``)."""
         if self.ctx.kernels:
             return self._radiance_kernel(origins, dirs, rng, sampler)
@@ -288,6 +294,7 @@ class PathTracer:
         self.rays += len(o)
         if bounce == 0:
             self.primary_hits += int(hits.hit.sum())
+            self._hit_rows = hits.hit
         if ctx.kernels:
             ray_kernels.add_rows(out, pixel, beta * ctx.background, ~hits.hit)
         else:
@@ -487,6 +494,13 @@ def _add(out: np.ndarray, pixel: np.ndarray, value: np.ndarray) -> None:
             out[:, c] += np.bincount(pixel, weights=value[:, c], minlength=len(out))
 
 
+def passes_per_job(size: tuple[int, int], spp: int) -> int:
+    """Sample passes per job: an image smaller than a tile traces several in one wavefront
+    of about TILE_PATHS paths (the per-bounce overheads shared), in at least min(spp, 4)
+    jobs (progress to show, a cancel to honour)."""
+    return max(1, min(-(-spp // 4), TILE_PATHS // (size[0] * size[1])))
+
+
 def iter_pathtrace(scene: Scene, size: tuple[int, int], spp: int, seed: int = 0,
                    backend: str = "auto", local: str = "numba",
                    workers: int = 1, sampler: str | None = None) -> Iterator[Progress]:
@@ -512,7 +526,9 @@ def iter_pathtrace(scene: Scene, size: tuple[int, int], spp: int, seed: int = 0,
         raise ShadeLabError(f"--spp {spp}: expected an integer >= 1")
     rows = max(1, TILE_PATHS // width)
     tiles = [(r, min(r + rows, height)) for r in range(0, height, rows)]
-    jobs = [(sample, r0, r1) for sample in range(spp) for r0, r1 in tiles]
+    batch = passes_per_job(size, spp)
+    jobs = [(sample, r0, r1, min(batch, spp - sample)) for sample in range(0, spp, batch)
+            for r0, r1 in tiles]
     setup = (scene, size, spp, seed, backend, local, sampler)
     if workers > 1 and len(jobs) > 1:
         from shadelab.raytrace.pool import traced_in_pool
@@ -530,12 +546,13 @@ def iter_pathtrace(scene: Scene, size: tuple[int, int], spp: int, seed: int = 0,
     image = np.zeros((height, width, 3), np.float32)
     rays = hits = 0
     start = time.perf_counter()
-    for done, ((sample, r0, r1), (radiance, tile_rays, tile_hits)) in enumerate(results, 1):
+    for done, ((sample, r0, r1, passes), (radiance, tile_rays, tile_hits)) in enumerate(
+            results, 1):
         rays += tile_rays
         hits += tile_hits if sample == 0 else 0
         part = slice(r0 * width, r1 * width)
         total[part] += radiance
-        count[part] += 1
+        count[part] += passes
         image[r0:r1] = (total[part] / count[part, None]).reshape(r1 - r0, width, 3)
         elapsed = time.perf_counter() - start
         samples = int(count.sum())
@@ -545,11 +562,12 @@ def iter_pathtrace(scene: Scene, size: tuple[int, int], spp: int, seed: int = 0,
                  "primary_hits": hits if done >= len(tiles) else 1,
                  "backend": name, "spp": spp, "workers": workers}
         yield Progress(image.copy(), done / len(jobs),
-                       f"sample {sample + 1}/{spp}, rows {r1}/{height}", stats)
+                       f"sample {sample + passes}/{spp}, rows {r1}/{height}", stats)
 
 
 class TileJob:
-    """Traces tile (pass, r0, r1): its jittered camera rays and one path per pixel."""
+    """Traces tile (pass, r0, r1, passes): its jittered camera rays and one path per pixel
+    for each of the passes pass .. pass + passes - 1, all in one wavefront."""
 
     def __init__(self, scene: Scene, size: tuple[int, int], spp: int, seed: int,
                  backend: str, local: str, sampler: str = "sobol"):
@@ -565,24 +583,32 @@ class TileJob:
         self.eye = np.asarray(cam.eye, dtype=np.float64)
         self.tan_half = tan_half_fov_y(cam, size[0] / size[1])
 
-    def __call__(self, sample: int, r0: int, r1: int):
-        """(radiance (n, 3), rays cast, primary hits) of one tile."""
+    def __call__(self, sample: int, r0: int, r1: int, passes: int = 1):
+        """(radiance summed over the passes (n, 3), rays cast, primary hits of the first
+        pass) of one tile."""
         width, height = self.size
-        rng = np.random.default_rng([self.seed, sample, r0])
+        n = (r1 - r0) * width
+        rng = np.random.default_rng([self.seed, sample, r0] if passes == 1
+                                    else [self.seed, sample, r0, passes])
         sobol = None
         if self.sampler == "sobol":  # pixel positions: each pixel's Sobol' pair 0
-            sobol = SobolSampler(self.seed, sample, r0 * width)
-            jitter = sobol.jitter((r1 - r0) * width).reshape(r1 - r0, width, 2)
+            sobol = SobolSampler(self.seed, np.tile(r0 * width + np.arange(n), passes),
+                                 np.repeat(sample + np.arange(passes), n))
+            jitters = sobol.jitter().reshape(passes, r1 - r0, width, 2)
         else:  # stratified pixel positions: sample s jitters inside stratum s
-            jitter = (rng.random((r1 - r0, width, 2)) if self.spp == 1
-                      else stratified_jitter(self.spp, sample, (r1 - r0, width), rng))
+            jitters = [rng.random((r1 - r0, width, 2)) if self.spp == 1
+                       else stratified_jitter(self.spp, s, (r1 - r0, width), rng)
+                       for s in range(sample, sample + passes)]
         forward, right, up = self.frame
-        o, d = ray_kernels.camera_rays(self.eye, forward, right, up, self.tan_half, width, height,
-                                   r0, r1, jitter)
-        before_rays, before_hits = self.tracer.rays, self.tracer.primary_hits
+        rays = [ray_kernels.camera_rays(self.eye, forward, right, up, self.tan_half, width,
+                                        height, r0, r1, jitter) for jitter in jitters]
+        o = rays[0][0] if passes == 1 else np.concatenate([r[0] for r in rays])
+        d = rays[0][1] if passes == 1 else np.concatenate([r[1] for r in rays])
+        before_rays = self.tracer.rays
         radiance = self.tracer.radiance(o, d, rng, sobol)
-        return (radiance, self.tracer.rays - before_rays,
-                self.tracer.primary_hits - before_hits)
+        if passes > 1:
+            radiance = radiance.reshape(passes, n, 3).sum(axis=0)
+        return radiance, self.tracer.rays - before_rays, self.tracer.first_hits(n)
 
 
 _WORKER_JOB: TileJob | None = None
@@ -593,8 +619,8 @@ def _init_worker(*setup) -> None:
     _WORKER_JOB = TileJob(*setup)
 
 
-def _trace_tile(sample: int, r0: int, r1: int):
-    return _WORKER_JOB(sample, r0, r1)
+def _trace_tile(sample: int, r0: int, r1: int, passes: int = 1):
+    return _WORKER_JOB(sample, r0, r1, passes)
 
 
 def render_pathtraced(scene: Scene, size: tuple[int, int], spp: int, seed: int = 0,

@@ -101,25 +101,27 @@ def sample_2d(pixel_seed, pair, index):
 
 
 @nb.njit(cache=True)
-def sobol_pairs(seed, pixels, pair, index):
-    """(n, 2): pair ``pair`` of sample ``index`` for each pixel id."""
+def sobol_pairs(seed, pixels, pair, indices):
+    """(n, 2): pair ``pair`` of sample ``indices[i]`` of pixel ``pixels[i]``."""
     n = len(pixels)
     out = np.empty((n, 2))
     for i in range(n):
-        out[i, 0], out[i, 1] = sample_2d(_pixel_seed(seed, pixels[i]), pair, index)
+        out[i, 0], out[i, 1] = sample_2d(_pixel_seed(seed, pixels[i]), pair, indices[i])
     return out
 
 
 @nb.njit(cache=True)
-def vertex_uniforms(seed, pixels, index, bounce, em_cdf):
+def vertex_uniforms(seed, pixels, indices, bounce, em_cdf):
     """The 7 uniforms per path of :func:`shadelab.raytrace.vertex.path_vertex` (emitter,
-    2 barycentrics, lobe, 2 direction, roulette) from pairs 1 + 3b, 2 + 3b and 3 + 3b."""
+    2 barycentrics, lobe, 2 direction, roulette) from pairs 1 + 3b, 2 + 3b and 3 + 3b of
+    sample ``indices[i]`` of pixel ``pixels[i]``."""
     n = len(pixels)
     out = np.empty((n, 7))
     base = 1 + 3 * bounce
     n_em = len(em_cdf)
     for i in range(n):
         ps = _pixel_seed(seed, pixels[i])
+        index = indices[i]
         u, v = sample_2d(ps, base, index)
         out[i, 0], out[i, 2] = u, v
         # the first barycentric variable: u re-scaled inside its triangle's CDF stretch
@@ -136,21 +138,20 @@ def vertex_uniforms(seed, pixels, index, bounce, em_cdf):
 
 
 class SobolSampler:
-    """The Sobol' draws of one tile: ``pixels`` are the image's pixel ids (row-major) of
-    the tile's paths, ``index`` the sample pass."""
+    """The Sobol' draws of a batch of paths: path i is sample ``indices[i]`` of the image's
+    pixel ``pixels[i]`` (row-major ids)."""
 
-    def __init__(self, seed: int, index: int, first_pixel: int = 0):
+    def __init__(self, seed: int, pixels: np.ndarray, indices: np.ndarray):
         self.seed = int(seed) & _MASK
-        self.index = int(index)
-        self.first_pixel = int(first_pixel)
+        self.pixels = np.ascontiguousarray(pixels, dtype=np.int64)
+        self.indices = np.ascontiguousarray(np.broadcast_to(indices, self.pixels.shape),
+                                            dtype=np.int64)
 
-    def jitter(self, count: int) -> np.ndarray:
-        """(count, 2) pixel offsets in [0, 1) of the tile's pixels."""
-        pixels = self.first_pixel + np.arange(count, dtype=np.int64)
-        return sobol_pairs(self.seed, pixels, 0, self.index)
+    def jitter(self) -> np.ndarray:
+        """(n, 2) pixel offsets in [0, 1) of the paths."""
+        return sobol_pairs(self.seed, self.pixels, 0, self.indices)
 
-    def vertex(self, local_pixels: np.ndarray, bounce: int, em_cdf: np.ndarray) -> np.ndarray:
-        """(n, 7) uniforms of the path vertex ``bounce`` of the tile's paths."""
-        pixels = self.first_pixel + np.asarray(local_pixels, dtype=np.int64)
-        return vertex_uniforms(self.seed, pixels, self.index, bounce,
+    def vertex(self, paths: np.ndarray, bounce: int, em_cdf: np.ndarray) -> np.ndarray:
+        """(len(paths), 7) uniforms of the path vertex ``bounce`` of those paths."""
+        return vertex_uniforms(self.seed, self.pixels[paths], self.indices[paths], bounce,
                                np.ascontiguousarray(em_cdf, dtype=np.float64))
