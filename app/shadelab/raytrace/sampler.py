@@ -69,19 +69,31 @@ def _owen(v, seed):
     return _reverse_bits(v)
 
 
+def _dimension1_bytes() -> np.ndarray:
+    """Sobol' dimension 1 (direction numbers v_1 = 2^31, v_k+1 = v_k ^ (v_k >> 1)) as four
+    tables of 256: the XOR of the columns of each byte of the index."""
+    v = [0x80000000]
+    for _ in range(31):
+        v.append(v[-1] ^ (v[-1] >> 1))
+    table = np.zeros((4, 256), np.int64)
+    for byte in range(4):
+        for value in range(256):
+            y = 0
+            for bit in range(8):
+                if value >> bit & 1:
+                    y ^= v[8 * byte + bit]
+            table[byte, value] = y
+    return table
+
+
+_DIM1 = _dimension1_bytes()
+
+
 @nb.njit(cache=True, inline="always")
 def _sobol2(index):
     """Sobol' dimensions 0 and 1 of ``index`` as 32-bit fractions."""
-    x = _reverse_bits(index)
-    y = 0
-    v = 0x80000000
-    i = index
-    while i:
-        if i & 1:
-            y ^= v
-        i >>= 1
-        v ^= v >> 1
-    return x, y
+    return _reverse_bits(index), (_DIM1[0, index & 255] ^ _DIM1[1, (index >> 8) & 255]
+                                  ^ _DIM1[2, (index >> 16) & 255] ^ _DIM1[3, index >> 24])
 
 
 @nb.njit(cache=True, inline="always")
