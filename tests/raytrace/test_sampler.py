@@ -154,4 +154,5 @@ def test_passes_in_one_wavefront_trace_what_they_trace_one_by_one():
     np.testing.assert_allclose(together, sum(a[0] for a in apart), rtol=1e-9, atol=1e-12)
     assert hits == apart[0][2] > 0
     assert passes_per_job(size, 64) == 16 and passes_per_job(size, 3) == 1
+    assert passes_per_job((64, 64), 64) == 16 and passes_per_job((128, 128), 64) == 1
     assert passes_per_job((512, 512), 64) == 1
