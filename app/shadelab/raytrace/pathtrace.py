@@ -40,6 +40,11 @@ Estimator (per path vertex, all paths of a bounce as one numpy batch, rays cast 
   radiance (not light-sampled; black in the Cornell presets).
 
 Emitters are two-sided (a closed furnace box converges to Le / (1 - rho) seen from inside).
+
+Samples: by default (``raytrace.sampler = "sobol"``) every 2-D decision of a path (pixel
+jitter, emitter point, BSDF direction, lobe choice and roulette) draws Owen-scrambled
+Sobol' points per pixel (:mod:`shadelab.raytrace.sampler`), so each pixel's samples are
+stratified in each pair; ``"independent"`` draws uniforms from each tile's generator.
 """
 
 from __future__ import annotations
