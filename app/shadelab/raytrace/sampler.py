@@ -112,17 +112,17 @@ def sample_2d(pixel_seed, pair, index):
     return x * _TO_UNIT, y * _TO_UNIT
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, parallel=True)
 def sobol_pairs(seed, pixels, pair, indices):
     """(n, 2): pair ``pair`` of sample ``indices[i]`` of pixel ``pixels[i]``."""
     n = len(pixels)
     out = np.empty((n, 2))
-    for i in range(n):
+    for i in nb.prange(n):
         out[i, 0], out[i, 1] = sample_2d(_pixel_seed(seed, pixels[i]), pair, indices[i])
     return out
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, parallel=True)
 def vertex_uniforms(seed, pixels, indices, bounce, em_cdf):
     """The 7 uniforms per path of :func:`shadelab.raytrace.vertex.path_vertex` (emitter,
     2 barycentrics, lobe, 2 direction, roulette) from pairs 1 + 3b, 2 + 3b and 3 + 3b of
@@ -131,7 +131,7 @@ def vertex_uniforms(seed, pixels, indices, bounce, em_cdf):
     out = np.empty((n, 7))
     base = 1 + 3 * bounce
     n_em = len(em_cdf)
-    for i in range(n):
+    for i in nb.prange(n):
         ps = _pixel_seed(seed, pixels[i])
         index = indices[i]
         u, v = sample_2d(ps, base, index)
