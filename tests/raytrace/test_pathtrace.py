@@ -23,12 +23,14 @@ def _furnace(rho: tuple, le: tuple) -> Scene:
                  objects=[Object(shape="box", material="m", extents=(2.0, 2.0, 2.0))])
 
 
+@pytest.mark.parametrize("sampler", ["sobol", "independent"])
 @pytest.mark.parametrize("rho, spread", [((0.5, 0.45, 0.4), 0.25), ((0.8, 0.7, 0.3), 0.4)])
-def test_furnace_converges_to_le_over_one_minus_rho(rho, spread):
+def test_furnace_converges_to_le_over_one_minus_rho(rho, spread, sampler):
     """L = Le / (1 - rho) everywhere: image mean within 2 %, 99 % of pixels within
-    ``spread`` (32 samples per pixel; longer paths at rho 0.8 are noisier)."""
+    ``spread`` (32 samples per pixel; longer paths at rho 0.8 are noisier), with either
+    sampler."""
     le = np.array([1.0, 0.5, 2.0])
-    image = render_pathtraced(_furnace(rho, tuple(le)), (24, 24), 32, seed=1)
+    image = render_pathtraced(_furnace(rho, tuple(le)), (24, 24), 32, seed=1, sampler=sampler)
     expected = le / (1.0 - np.array(rho))
     ratio = image.reshape(-1, 3) / expected
     np.testing.assert_allclose(ratio.mean(axis=0), 1.0, atol=0.02)
@@ -58,8 +60,9 @@ def _signed_corner(x: float, y: float) -> float:
     return math.copysign(1.0, x) * math.copysign(1.0, y) * _corner_factor(abs(x), abs(y))
 
 
-def test_direct_light_from_a_square_emitter_matches_the_form_factor():
-    """A floor under a square emitter: L = rho Le F(point -> square), F in closed form."""
+def _square_emitter_scene(size: tuple[int, int]) -> tuple[Scene, np.ndarray]:
+    """A floor under a square emitter and its radiance at the pixel centres:
+    L = rho Le F(point -> square), F in closed form."""
     h, half = 1.0, 0.5
     le, rho = 3.0, 0.6
     floor = Object(shape="quad", material="floor",
@@ -71,8 +74,6 @@ def test_direct_light_from_a_square_emitter_matches_the_form_factor():
                              "lamp": Material(ka=0, kd=0.0, ks=0.0, emission=(le,) * 3)},
                   camera=Camera(eye=(0.0, 0.6, 2.0), target=(0.0, 0.0, 0.0), fov_y=8.0),
                   objects=[floor, lamp])
-    size = (8, 8)
-    image = render_pathtraced(scene, size, 256, seed=2)
     o, d = primary_rays(scene.camera, *size)
     t = -o[..., 1] / d[..., 1]
     p = o + t[..., None] * d
@@ -83,8 +84,28 @@ def test_direct_light_from_a_square_emitter_matches_the_form_factor():
             f = sum(sx * sz * _signed_corner((cx - x) / h, (cz - z) / h)
                     for cx, sx in ((half, 1), (-half, -1)) for cz, sz in ((half, 1), (-half, -1)))
             expected[j, i] = rho * le * f
+    return scene, expected
+
+
+def test_direct_light_from_a_square_emitter_matches_the_form_factor():
+    """A floor under a square emitter: L = rho Le F(point -> square), F in closed form."""
+    size = (8, 8)
+    scene, expected = _square_emitter_scene(size)
+    image = render_pathtraced(scene, size, 256, seed=2)
     np.testing.assert_allclose(image[..., 0].mean(), expected.mean(), rtol=0.02)
     np.testing.assert_allclose(image[..., 0], expected, rtol=0.15)
+
+
+def test_sobol_samples_reach_the_form_factor_with_a_quarter_of_the_samples():
+    """The same floor at 64 spp with the (default) Sobol' sampler: RMS relative error over
+    the pixels below 3 %, every pixel within 10 % (independent samples measured ~5 % RMS,
+    12-22 % worst pixel; Sobol' ~1.7 % RMS, 4-5.5 %, part of it the pixel footprint's
+    variation about the centre's closed form)."""
+    size = (8, 8)
+    scene, expected = _square_emitter_scene(size)
+    rel = render_pathtraced(scene, size, 64, seed=2)[..., 0] / expected - 1.0
+    assert np.sqrt(np.mean(rel ** 2)) < 0.03
+    assert np.abs(rel).max() < 0.10
 
 
 def test_emitter_seen_by_the_camera_is_its_radiance():

@@ -11,7 +11,7 @@ import numba
 import numpy as np
 
 from shadelab.raytrace.accel import BvhAccel, accel_threads, embree_available
-from shadelab.raytrace.pathtrace import PathTracer
+from shadelab.raytrace.pathtrace import TileJob, passes_per_job
 from shadelab.raytrace.surface import TraceContext
 from shadelab.raytrace.whitted import iter_raytrace
 from shadelab.scene.camera import primary_rays, tan_half_fov_y
@@ -102,39 +102,41 @@ def _whitted_and_raw(size: tuple[int, int], repeats: int, overrides=()) -> dict:
     return report
 
 
-def _pathtrace(size: tuple[int, int], spp: int, repeats: int) -> dict:
+MITSUBA_SAMPLERS = ("independent", "stratified", "ldsampler", "multijitter")
+OUR_SAMPLERS = ("sobol", "independent")
+
+
+def _pathtrace(size: tuple[int, int], spp: int, sampler: str = "sobol"):
+    """Our path tracer on cornell as ``render_pathtraced`` runs it (camera jitter, the
+    sampler's draws, the same jobs: ``passes_per_job`` passes per wavefront when the image
+    is small; scene set-up left out, as Mitsuba's is): (render function, info)."""
     scene = load_preset("cornell")
-    tracer = PathTracer(scene)
-    o, d = primary_rays(scene.camera, *size)
-    o, d = o.reshape(-1, 3), d.reshape(-1, 3)
-    rng = np.random.default_rng(0)
+    job = TileJob(scene, size, spp, 0, "auto", "numba", sampler)
+    tracer = job.tracer
+    batch = passes_per_job(size, spp)
 
     def render():
-        for _ in range(spp):
-            tracer.radiance(o, d, rng)
+        for sample in range(0, spp, batch):
+            job(sample, 0, size[1], min(batch, spp - sample))
 
-    tracer.rays = 0
-    timing = median_time(render, repeats, warmup=1)
-    samples = size[0] * size[1] * spp
-    seconds = timing["median_ms"] / 1000.0
-    return {"scene": "cornell", "size": list(size), "spp": spp, **timing,
-            "samples_per_s": samples / seconds,
-            "rays_per_sample": tracer.rays / (samples * (repeats + 1)),
-            "backend": tracer.ctx.accel.name}
+    return render, {"scene": "cornell", "size": list(size), "spp": spp, "sampler": sampler,
+                    "passes_per_wavefront": batch, "backend": tracer.ctx.accel.name,
+                    "tracer": tracer}
 
 
-def _mitsuba(size, spp: int, repeats: int) -> dict:
+def _mitsuba(size, spp: int, sampler: str = "independent"):
     """Mitsuba 3's ``path`` integrator (NEE + MIS + Russian roulette, max_depth -1) on the
     same Cornell box: our preset's triangles, diffuse reflectances kd * Od, the emitter's
-    radiance and our camera, on the ``llvm_ad_rgb`` variant; samples/s in the same run.
-    Mitsuba only where the optional ``bench`` extra is installed (and libLLVM for Dr.Jit)."""
+    radiance and our camera, on the ``llvm_ad_rgb`` variant, with its ``sampler``:
+    (render function, info) or (None, {"available": False, "why": ...}). Mitsuba only where
+    the optional ``bench`` extra is installed (and libLLVM for Dr.Jit)."""
     try:
         import drjit as dr
         import mitsuba as mi
 
         mi.set_variant("llvm_ad_rgb")
     except Exception as exc:  # not installed, or Dr.Jit found no LLVM
-        return {"available": False, "why": f"{type(exc).__name__}: {exc}"[:300]}
+        return None, {"available": False, "why": f"{type(exc).__name__}: {exc}"[:300]}
     from shadelab.geometry.mesh import scene_meshes
 
     scene = load_preset("cornell")
@@ -165,20 +167,25 @@ def _mitsuba(size, spp: int, repeats: int) -> dict:
                                                               up=list(cam.up)),
                    "film": {"type": "hdrfilm", "width": width, "height": height,
                             "rfilter": {"type": "box"}},
-                   "sampler": {"type": "independent", "sample_count": spp}},
+                   "sampler": {"type": sampler, "sample_count": spp}},
         **shapes})
+    count = mscene.sensors()[0].sampler().sample_count()
 
-    def render():
-        dr.eval(mi.render(mscene, spp=spp))
+    def render(seed: int = 0):
+        return mi.render(mscene, spp=spp, seed=seed)
 
-    timing = median_time(render, repeats, warmup=1)
-    samples = width * height * spp
-    return {"available": True, "scene": "cornell (our triangles, kd Od, Le, camera)",
-            "variant": "llvm_ad_rgb", "integrator": "path (NEE + MIS + RR)",
-            "size": list(size), "spp": spp, **timing, "version": mi.__version__,
-            "samples_per_s": samples / (timing["median_ms"] / 1000.0),
-            "image": lambda seed: np.array(mi.render(mscene, spp=spp, seed=seed),
-                                           dtype=np.float64)[..., :3]}
+    def image(seed: int) -> np.ndarray:
+        return np.array(render(seed), dtype=np.float64)[..., :3]
+
+    def render_and_wait():
+        dr.eval(render())
+        dr.sync_thread()   # the LLVM backend launches asynchronously: wait for the kernels
+
+    return render_and_wait, {
+        "available": True, "scene": "cornell (our triangles, kd Od, Le, camera)",
+        "variant": "llvm_ad_rgb", "integrator": "path (NEE + MIS + RR)", "sampler": sampler,
+        "sample_count": count, "size": list(size), "spp": spp, "version": mi.__version__,
+        "image": image}
 
 
 def away_from_emitters(mean: np.ndarray, level: float = 1.0) -> np.ndarray:
@@ -206,24 +213,79 @@ def variance_per_sample(images: np.ndarray, spp: int, mask: np.ndarray | None = 
     return float(var.sum() / max((mean ** 2).sum(), 1e-300))
 
 
-def equal_error(size, spp: int, mitsuba: dict, seeds: int = 4) -> dict:
-    """The path tracers at equal error: each one's noise per sample (``variance_per_sample``
-    over ``seeds`` independent images) and their agreement in the mean; the time to a given
-    error is variance / (samples/s), so the equal-error ratio is the samples/s ratio times
-    Mitsuba's variance over ours."""
+def _images(render_seed, seeds: int) -> np.ndarray:
+    return np.stack([render_seed(100 + k) for k in range(seeds)])
+
+
+def pathtrace_vs_mitsuba(size, spp: int, repeats: int, seeds: int = 4) -> dict:
+    """Our path tracer (each of ``OUR_SAMPLERS``) against Mitsuba's ``path`` with each of
+    ``MITSUBA_SAMPLERS``, all at ``spp`` (a power of 4: what the stratified, low-discrepancy
+    and multi-jitter samplers are made for) on the same Cornell box.
+
+    Speed: samples/s of each, timed in turn in the same rounds (``_interleaved``: a shared
+    machine's load falls on all alike); noise: each one's ``variance_per_sample`` over
+    ``seeds`` images, on the pixels away from the light's outline. Time to a given error is
+    variance / (samples/s), so the equal-error ratio against one Mitsuba sampler is the
+    paired samples/s ratio times its variance over ours (> 1: we get there first).
+    """
     from shadelab.raytrace.pathtrace import render_pathtraced
 
     scene = load_preset("cornell")
-    ours = np.stack([render_pathtraced(scene, size, spp, seed=100 + k) for k in range(seeds)])
-    theirs = np.stack([mitsuba["image"](100 + k) for k in range(seeds)])
-    a, b = ours.mean(axis=0), theirs.mean(axis=0)
-    mask = away_from_emitters(b) & away_from_emitters(a)
-    return {"seeds": seeds, "spp": spp, "size": list(size),
+    fns, ours, theirs = {}, {}, {}
+    for name in OUR_SAMPLERS:
+        fns[f"ours_{name}"], ours[name] = _pathtrace(size, spp, name)
+    for name in MITSUBA_SAMPLERS:
+        render, info = _mitsuba(size, spp, name)
+        if render is None:
+            return {"ours": {k: _public(v) for k, v in ours.items()}, "mitsuba": info}
+        fns[f"mitsuba_{name}"], theirs[name] = render, info
+    for info in ours.values():
+        info["tracer"].rays = 0
+    timed = _interleaved(fns, repeats)
+    samples = size[0] * size[1] * spp
+    for name, info in ours.items():
+        t = timed[f"ours_{name}"]
+        info.update({k: v for k, v in t.items() if not k.startswith("_")})
+        info["samples_per_s"] = samples / (t["median_ms"] / 1000.0)
+        info["rays_per_sample"] = info["tracer"].rays / (samples * (repeats + 1))
+    for name, info in theirs.items():
+        t = timed[f"mitsuba_{name}"]
+        info.update({k: v for k, v in t.items() if not k.startswith("_")})
+        info["samples_per_s"] = samples / (t["median_ms"] / 1000.0)
+    images = {f"ours_{name}": _images(
+        lambda seed, name=name: render_pathtraced(scene, size, spp, seed=seed, sampler=name),
+        seeds) for name in ours}
+    images.update({f"mitsuba_{name}": _images(info["image"], seeds)
+                   for name, info in theirs.items()})
+    means = {key: im.mean(axis=0) for key, im in images.items()}
+    mask = np.logical_and.reduce([away_from_emitters(m) for m in means.values()])
+    reference = np.mean([m for key, m in means.items() if key.startswith("mitsuba_")], axis=0)
+    for key, im in images.items():
+        info = ours[key[5:]] if key.startswith("ours_") else theirs[key[8:]]
+        info["variance_per_sample"] = variance_per_sample(im, spp, mask)
+        info["mean_relative_l1_vs_mitsuba"] = float(
+            np.abs(means[key] - reference)[mask].sum() / max(reference[mask].sum(), 1e-300))
+    ratios = {}
+    for our_name, our in ours.items():
+        for name, info in theirs.items():
+            speed = _paired_ratio(timed[f"ours_{our_name}"], timed[f"mitsuba_{name}"],
+                                  "_wall", samples, samples)
+            cpu = _paired_ratio(timed[f"ours_{our_name}"], timed[f"mitsuba_{name}"],
+                                "_cpu", samples, samples)
+            noise = info["variance_per_sample"] / max(our["variance_per_sample"], 1e-300)
+            ratios[f"{our_name}_vs_{name}"] = {
+                "samples_per_s_ratio": speed, "equal_error_ratio": speed * noise,
+                # per CPU second (process time, all threads): what a loaded machine's
+                # wall clock blurs
+                "samples_per_cpu_s_ratio": cpu, "equal_error_ratio_cpu": cpu * noise}
+    return {"size": list(size), "spp": spp, "seeds": seeds, "repeats": repeats,
             "pixels": "away from the light's outline (away_from_emitters)",
-            "variance_per_sample_ours": variance_per_sample(ours, spp, mask),
-            "variance_per_sample_mitsuba": variance_per_sample(theirs, spp, mask),
-            "mean_relative_l1": float(np.abs(a - b)[mask].sum()
-                                      / max(np.abs(b)[mask].sum(), 1e-300))}
+            "ours": {k: _public(v) for k, v in ours.items()},
+            "mitsuba": {k: _public(v) for k, v in theirs.items()}, "ratios": ratios}
+
+
+def _public(info: dict) -> dict:
+    return {k: v for k, v in info.items() if k not in ("tracer", "image")}
 
 
 def whitted_scaling(quick: bool) -> dict:
@@ -265,21 +327,24 @@ def run(quick: bool) -> dict:
                                       **{k: tinted["whitted"][k] for k in
                                          ("median_ms", "rays", "rays_per_s")}}
     report["scaling_whitted"] = whitted_scaling(quick)
-    pt_size, pt_spp, pt_repeats = (64, 64) if quick else (128, 128), 4 if quick else 8, \
-        2 if quick else 5
-    report["pathtrace"] = _pathtrace(pt_size, pt_spp, pt_repeats)
-    report["mitsuba_path"] = _mitsuba(pt_size, pt_spp, pt_repeats)
-    if report["mitsuba_path"]["available"]:  # goal >= 0.7 (issue 13.3)
-        report["pathtrace_vs_mitsuba"] = (report["pathtrace"]["samples_per_s"]
-                                          / report["mitsuba_path"]["samples_per_s"])
-        errors = equal_error(pt_size, pt_spp * 4, report["mitsuba_path"])
-        report["pathtrace_equal_error"] = errors
-        report["pathtrace_vs_mitsuba_equal_error"] = (
-            report["pathtrace_vs_mitsuba"] * errors["variance_per_sample_mitsuba"]
-            / max(errors["variance_per_sample_ours"], 1e-300))
-        report["mitsuba_path"].pop("image")
+    # Every sampler at 64 spp (a power of 4), timed in turn in the same rounds
+    pt_size, pt_spp, pt_repeats = (64, 64) if quick else (128, 128), 64, 2 if quick else 4
+    pt = pathtrace_vs_mitsuba(pt_size, pt_spp, pt_repeats, seeds=4)
+    report["pathtrace_samplers"] = pt
+    report["pathtrace"] = pt["ours"]["sobol"]
+    report["mitsuba_path"] = pt["mitsuba"].get("independent", pt["mitsuba"])
+    if "ratios" in pt:
+        # Goal >= 0.7 (issue 19): against Mitsuba's best sampler, the default samplers' pair
+        versus = {name: pt["ratios"][f"sobol_vs_{name}"] for name in pt["mitsuba"]}
+        best = min(versus, key=lambda name: versus[name]["equal_error_ratio"])
+        report["pathtrace_vs_mitsuba"] = versus["independent"]["samples_per_s_ratio"]
+        report["pathtrace_vs_mitsuba_best_sampler"] = best
+        report["pathtrace_vs_mitsuba_equal_error"] = versus[best]["equal_error_ratio"]
+        report["pathtrace_vs_mitsuba_equal_error_by_sampler"] = {
+            name: v["equal_error_ratio"] for name, v in versus.items()}
+        report["pathtrace_vs_mitsuba_equal_error_cpu"] = versus[best]["equal_error_ratio_cpu"]
     else:
         report["pathtrace_vs_mitsuba"] = None
         report["pathtrace_vs_mitsuba_why"] = ("mitsuba not available here: "
-                                              + report["mitsuba_path"]["why"])
+                                              + pt["mitsuba"]["why"])
     return report

@@ -88,7 +88,7 @@ def _next_event(i, m, emitters, rho, lobes, beta, px, py, pz, nx, ny, nz, gx, gy
             nee_val[i, c] += beta[i, c] * ks_os[m, c] * em_le[k, c] * glossy
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, parallel=True)
 def path_vertex(out, pixel, beta, bsdf_pdf, position, normal, geo, entering, dirs, t, mat,
                 surfaces, lobes, emitters, eps, rnd, roulette, blinn):
     """One path vertex per path: emission (MIS-weighted), next-event set-up, lobe choice.
@@ -118,7 +118,7 @@ def path_vertex(out, pixel, beta, bsdf_pdf, position, normal, geo, entering, dir
     new_pdf = np.zeros(n)
     alive = np.zeros(n, np.bool_)
     n_em = len(emitters[0])
-    for i in range(n):
+    for i in nb.prange(n):  # each path writes its own rows (``pixel`` has no repeats)
         m = mat[i]
         px, py, pz = position[i, 0], position[i, 1], position[i, 2]
         nx, ny, nz = normal[i, 0], normal[i, 1], normal[i, 2]

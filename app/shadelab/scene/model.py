@@ -235,6 +235,8 @@ class RaytraceSettings(Checked):
     min_weight: float = spec(0.01, "float", 0.0, 1.0, doc="stop a ray below this weight")
     offset: float = spec(1e-3, "float", 0.0, LENGTH_MAX, doc="ray origin offset, scene-relative")
     fresnel: bool = spec(False, "bool", doc="weight reflection/refraction by Fresnel")
+    sampler: str = spec("sobol", "str", ("sobol", "independent"),
+                        doc="path tracer's samples: sobol (Owen-scrambled) | independent")
 
 
 @dataclass
