@@ -41,8 +41,8 @@ def test_load_case_scene_applies_overrides_and_the_raster_shading():
     assert scene.render.shading == "flat" and scene.objects[0].subdivisions == 2
     assert load_case_scene(case_named("gouraud-highlight")).render.shading == "gouraud"
     assert case_shading(case_named("shadow-acne")) is None
-    assert offline_job_of(case_named("shadow-acne")) == "Whitted"
-    assert offline_job_of(case_named("radiosity-light-leak")) == "Radiosity"
+    assert offline_job_of(case_named("shadow-acne")) == "raytrace"   # registry names
+    assert offline_job_of(case_named("radiosity-light-leak")) == "radiosity"
     assert offline_job_of(case_named("mach-bands")) == ""
 
 

@@ -16,9 +16,6 @@ from shadelab.errors import ShadeLabError
 from shadelab.lab.jobs import JobRunner
 from shadelab.progress import Progress
 
-OFFLINE_JOB_OF_METHOD = {"raytrace": "Whitted", "pathtrace": "Path", "radiosity": "Radiosity"}
-
-
 # ---------------------------------------------------------------- running a study
 
 
@@ -175,8 +172,21 @@ def case_shading(case) -> str | None:
 
 
 def offline_job_of(case) -> str:
-    """The offline panel's job label prefix for a ray-traced or radiosity case ('' for raster)."""
-    return OFFLINE_JOB_OF_METHOD.get(case.method.partition(":")[0], "")
+    """The registry name of the offline pipeline a case is shown with ('' for raster)."""
+    from shadelab import pipelines
+
+    name = case.method.partition(":")[0]
+    if name not in pipelines.all_names() or pipelines.get(name).raster is not None:
+        return ""
+    return name
+
+
+def offline_job_label(case) -> str:
+    """The label of :func:`offline_job_of`'s pipeline ('' for raster)."""
+    from shadelab import pipelines
+
+    name = offline_job_of(case)
+    return pipelines.get(name).label if name else ""
 
 
 def load_case_scene(case):
@@ -205,7 +215,7 @@ def open_case(state, case) -> bool:
     state.replace_scene(scene, case.preset, new_file=True)
     state.studies.gallery_opened = case.name
     note = ""
-    job = offline_job_of(case)
+    job = offline_job_label(case)
     if job:
         note = f"; run the {job} offline renderer ({case.method}) to see the failure"
     state.error, state.status = "", f"opened gallery case {case.name} ({case.preset}){note}"

@@ -16,6 +16,7 @@ from shadelab.lab.studies import (
     StudyRun,
     auto_quality_line,
     cell,
+    offline_job_label,
     offline_job_of,
     open_case,
     plot_series,
@@ -216,7 +217,8 @@ def draw_gallery_panel(state: AppState) -> bool:
         if imgui.button("Run offline job") and open_case(state, case):
             start_job_by_label(state, job)
         imgui.end_disabled()
-        _wrapped(f"shown by the {job} offline renderer (Offline render panel)",
+        _wrapped(f"shown by the {offline_job_label(case)} offline renderer (Offline render "
+                 "panel)",
                  panels.DIM_COLOR)
     if state.studies.gallery_opened == case.name and not state.error:
         imgui.text_colored(panels.OK_COLOR, f"open: {state.scene.name or case.preset}, "
