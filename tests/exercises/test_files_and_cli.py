@@ -181,3 +181,18 @@ def test_the_shipped_set_covers_the_lecture_and_its_values_are_the_labs(capsys):
     light = shadelab.load_preset("lecture", {"lights.0.c1": 0.25}).lights[0]
     assert 1.0 / (light.c1 + 2 * light.c2 + 4 * light.c3) > 1.0   # the clamp is active
     assert any(line.split()[1] == "f-att-clamp" and ": 1 +/-" in line for line in key)
+
+
+def test_view_exercise_brings_the_exercise_window_forward():
+    """`shadelab view --exercise` opens the sheet and asks for its window in front (it was
+    docked behind the Equation tab, out of sight at 1024x768)."""
+    from shadelab.exercises.loader import load_exercise
+    from shadelab.lab.panel_names import unknown_panel
+    from shadelab.lab.state import AppState
+    from shadelab.scene.preset import load_preset
+    from shadelab.ui.exercise_panel import open_exercise, panel_of
+
+    state = AppState.from_scene(load_preset("lecture"), "lecture")
+    open_exercise(state, load_exercise("phong-to-radiosity"))
+    assert state.walk.focus_request == "Exercise" and unknown_panel("Exercise") is None
+    assert panel_of(state).index == 0

@@ -62,6 +62,7 @@ def open_exercise(state, exercise: Exercise) -> None:
     """Show ``exercise`` in the Exercise window (``shadelab view --exercise``)."""
     panel = panel_of(state)
     panel.exercise, panel.index, panel.tasks, panel.error = exercise, 0, {}, ""
+    state.walk.focus_request = "Exercise"  # brought to the front on the next frame
 
 
 # ---------------------------------------------------------------- images via state.gpu
