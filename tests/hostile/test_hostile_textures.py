@@ -45,3 +45,19 @@ def test_a_texture_past_the_gl_limit_is_drawn_not_black(shadelab, tmp_path):
     assert "GL_MAX_TEXTURE_SIZE" in err and len(err.splitlines()) <= 3, err
     image = np.load(tmp_path / "out.npy")
     assert np.median(image[image.sum(axis=2) > 0]) > 0.05  # the sphere is lit, not black
+
+
+@pytest.mark.parametrize("command", ["render", "raytrace"])
+def test_a_png_whose_text_chunk_is_a_decompression_bomb_is_one_line(shadelab, tmp_path,
+                                                                     command):
+    """A zTXt chunk that inflates past Pillow's MAX_TEXT_CHUNK: Pillow's ValueError reached
+    the user as a traceback from both renderers (issue 24, class 4)."""
+    from PIL import PngImagePlugin
+
+    info = PngImagePlugin.PngInfo()
+    info.add_text("comment", "x" * (PngImagePlugin.MAX_TEXT_CHUNK * 4), zip=True)
+    Image.fromarray(np.full((8, 8, 3), 90, np.uint8)).save(tmp_path / "wide.png", pnginfo=info)
+    (tmp_path / "p.toml").write_text(PRESET)
+    err = shadelab(command, "p.toml", "-o", "out.png", "--size", "16x12", code=2, timeout=180)
+    assert "materials.m.texture: 'wide.png' could not be read as an image" in err
+    assert "MAX_TEXT_CHUNK" in err and not (tmp_path / "out.png").exists()

@@ -99,8 +99,12 @@ def check_image_file(path: str, base_dir: str, key: str) -> tuple[int, int]:
     try:
         with _open_checked(full, key) as image:
             return image.size
-    except (UnidentifiedImageError, OSError) as exc:
-        raise ShadeLabError(f"{key}: '{full.name}' could not be read as an image ({exc})") from None
+    except (UnidentifiedImageError, OSError, ValueError, SyntaxError) as exc:
+        # ValueError: a text chunk past Pillow's decompression limit (a zTXt bomb) and other
+        # malformed chunks; SyntaxError: a broken header
+        reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise ShadeLabError(f"{key}: '{full.name}' could not be read as an image "
+                            f"({reason})") from None
 
 
 def load_image(path: str, base_dir: str, key: str, height: bool = False) -> np.ndarray:
@@ -109,8 +113,12 @@ def load_image(path: str, base_dir: str, key: str, height: bool = False) -> np.n
     try:
         with _open_checked(full, key) as image:
             pixels = np.asarray(image.convert("L" if height else "RGB"), dtype=np.float32)
-    except (UnidentifiedImageError, OSError) as exc:
-        raise ShadeLabError(f"{key}: '{full.name}' could not be read as an image ({exc})") from None
+    except (UnidentifiedImageError, OSError, ValueError, SyntaxError) as exc:
+        # ValueError: a text chunk past Pillow's decompression limit (a zTXt bomb) and other
+        # malformed chunks; SyntaxError: a broken header
+        reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise ShadeLabError(f"{key}: '{full.name}' could not be read as an image "
+                            f"({reason})") from None
     pixels = pixels[::-1] / 255.0
     if not height:
         pixels = srgb_to_linear(pixels)
