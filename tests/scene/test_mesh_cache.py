@@ -107,3 +107,26 @@ def test_keys_follow_every_input_and_the_cache_can_be_off(monkeypatch, tmp_path)
     (tmp_path / "ro").write_text("a file where the folder should be")
     cache.store("x", {"a": np.ones(2)})               # cannot write: ignored, no error
     assert cache.load("x") is None
+
+
+def test_a_cache_entry_that_is_a_fifo_is_a_miss_not_a_hang(tmp_path, monkeypatch):
+    """Issue 24, class 8: np.load opened a FIFO entry and waited for a writer forever."""
+    import os
+    import threading
+
+    from shadelab.geometry import cache
+
+    monkeypatch.setenv("SHADELAB_CACHE_DIR", str(tmp_path))
+    folder = cache.cache_dir()
+    folder.mkdir(parents=True, exist_ok=True)
+    os.mkfifo(folder / "entry.npz")
+    result = {}
+    reader = threading.Thread(target=lambda: result.update(value=cache.load("entry")),
+                              daemon=True)
+    reader.start()
+    reader.join(10.0)
+    assert not reader.is_alive(), "cache.load hung on a FIFO"
+    assert result["value"] is None
+    cache.store("entry", {"a": np.arange(3)})   # the FIFO is replaced by a real entry
+    assert (folder / "entry.npz").is_file()
+    np.testing.assert_array_equal(cache.load("entry")["a"], np.arange(3))

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import stat
 import tempfile
 from functools import lru_cache
 from pathlib import Path
@@ -72,8 +73,14 @@ def load(name: str) -> dict[str, np.ndarray] | None:
         return None
     path = folder / f"{name}.npz"
     try:
-        with np.load(path, allow_pickle=False) as data:
-            return {k: data[k] for k in data.files}
+        # Opened without blocking and read only if it is a regular file: an entry that is a
+        # FIFO (or a device) would hang np.load's open; it is a miss, rebuilt by store()
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+        with os.fdopen(fd, "rb") as handle:
+            if not stat.S_ISREG(os.fstat(handle.fileno()).st_mode):
+                return None
+            with np.load(handle, allow_pickle=False) as data:
+                return {k: data[k] for k in data.files}
     except (OSError, ValueError, EOFError, KeyError):  # missing, damaged, not an npz
         return None
     except Exception:  # noqa: BLE001 - zipfile.BadZipFile and kin: a cache miss, not an error
