@@ -18,6 +18,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--answers", metavar="ANSWERS.toml",
                    help="the student's answers: an [answers] table, task id = answer")
     p.add_argument("--json", metavar="OUT.json", help="write the graded record as JSON")
+    p.add_argument("--class", dest="class_dir", metavar="DIR",
+                   help="a folder of the class's graded .json records: per task, how many "
+                        "passed and the answers given (the teacher's view)")
     p.set_defaults(run=run_exercise)
 
 
@@ -49,6 +52,13 @@ def run_exercise(args: argparse.Namespace) -> int:
 
     exercise = load_exercise(args.exercise)
     _check_output(args, exercise.path)
+    if args.class_dir is not None:
+        from shadelab.exercises.grading import class_summary, load_class_results
+
+        rows = class_summary(exercise, load_class_results(args.class_dir))
+        for i, task in enumerate(exercise.tasks, 1):
+            print(f"{i:>2}. {task.id}  {rows[task.id].text()}")
+        return 0
     if args.answers is None:
         for i, task in enumerate(exercise.tasks, 1):
             task.render = api_render

@@ -51,3 +51,76 @@ def grade_exercise(exercise: Exercise, answers: dict[str, Any],
         task.render = render
         results.append(task.grade(answers.get(task.id)))
     return Report(exercise, results)
+
+
+@dataclass
+class ClassRow:
+    """One task across a class's graded sheets."""
+
+    passed: int
+    answered: int
+    sheets: int
+    answers: list[tuple[str, int]]   # the answers given, most common first (text, count)
+
+    def text(self) -> str:
+        common = ", ".join(f"{a} ({n})" for a, n in self.answers[:4]) or "none"
+        return (f"class: {self.passed}/{self.sheets} passed, {self.answered} answered; "
+                f"answers: {common}")
+
+
+def _answer_key(answer: Any) -> str:
+    """An answer as text, numbers to 3 significant digits (0.5500001 and 0.55 count as one)."""
+    if isinstance(answer, bool) or answer is None:
+        return str(answer)
+    if isinstance(answer, (int, float)):
+        return f"{answer:.3g}"
+    if isinstance(answer, (list, tuple)):
+        return "[" + ", ".join(_answer_key(a) for a in answer) + "]"
+    return str(answer)
+
+
+def class_summary(exercise: Exercise, records: list[dict]) -> dict[str, ClassRow]:
+    """Per task: how many of the class's graded records (``shadelab exercise --json``) passed
+    and answered it, and the answers given, most common first. A record of another exercise
+    file (its sha256 differs) is refused with one line naming it."""
+    from collections import Counter
+
+    from shadelab.errors import ShadeLabError
+
+    for i, record in enumerate(records):
+        if not isinstance(record, dict) or record.get("sha256") != exercise.sha256:
+            name = record.get("_file", f"record {i}") if isinstance(record, dict) else i
+            raise ShadeLabError(f"{name}: graded for another exercise file (its sha256 is not "
+                                f"{Path(exercise.path).name}'s)")
+    rows = {}
+    for task in exercise.tasks:
+        mine = [t for r in records for t in r.get("tasks", []) if t.get("id") == task.id]
+        given = [t for t in mine if t.get("verdict") != "unanswered"]
+        counts = Counter(_answer_key(t.get("answer")) for t in given)
+        rows[task.id] = ClassRow(sum(t.get("verdict") == "pass" for t in mine), len(given),
+                                 len(records), counts.most_common())
+    return rows
+
+
+def load_class_results(folder: str | Path) -> list[dict]:
+    """Every ``*.json`` graded record in ``folder`` (one line for a folder that is not one, a
+    file that is not JSON)."""
+    import json
+
+    from shadelab.errors import ShadeLabError
+
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise ShadeLabError(f"--class '{folder}': not a folder of graded .json records")
+    records = []
+    for path in sorted(folder.glob("*.json")):
+        try:
+            record = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+            raise ShadeLabError(f"{path.name}: not a graded record ({exc})") from None
+        if isinstance(record, dict):
+            record["_file"] = path.name
+        records.append(record)
+    if not records:
+        raise ShadeLabError(f"--class '{folder}': no .json graded records in it")
+    return records

@@ -46,6 +46,8 @@ class ExercisePanel:
     pending: set[str] = field(default_factory=set)   # gpu request keys waiting
     choice: int = 0
     uploaded: set[str] = field(default_factory=set)  # textures already sent (not per frame)
+    class_dir: str = ""                              # teacher: the class's graded records
+    class_rows: dict = field(default_factory=dict)   # task id -> grading.ClassRow
 
     def task_state(self, task) -> TaskState:
         return self.tasks.setdefault(task.id, TaskState())
@@ -62,6 +64,7 @@ def open_exercise(state, exercise: Exercise) -> None:
     """Show ``exercise`` in the Exercise window (``shadelab view --exercise``)."""
     panel = panel_of(state)
     panel.exercise, panel.index, panel.tasks, panel.error = exercise, 0, {}, ""
+    panel.class_rows = {}
     state.walk.focus_request = "Exercise"  # brought to the front on the next frame
 
 
@@ -181,6 +184,7 @@ def draw_exercise_panel(state) -> bool:
         if expected is not None:
             tol = "" if expected.tolerance is None else f" +/- {expected.tolerance:g}"
             imgui.text_wrapped(f"Answer: {task.answer_text(expected.value)}{tol}")
+        _draw_class(panel, task)
     _draw_answer(state, panel, task, ts, width)
     submit = imgui.button("Submit") and ts.answer is not None
     if ts.answer is None:
@@ -210,6 +214,28 @@ def draw_exercise_panel(state) -> bool:
             imgui.text(name)
             _show(state, f"reveal:{task.id}:{name}", image, min(width, 2.0 * image.shape[1]))
     return False
+
+
+def load_class(panel: ExercisePanel, folder: str) -> None:
+    """Teacher mode: the class's graded records (``shadelab exercise --json``) in ``folder``,
+    summed per task (an error is one line in the panel)."""
+    from shadelab.exercises.grading import class_summary, load_class_results
+
+    try:
+        panel.class_rows = class_summary(panel.exercise, load_class_results(folder))
+        panel.class_dir, panel.error = folder, ""
+    except ShadeLabError as exc:
+        panel.class_rows, panel.error = {}, str(exc)
+
+
+def _draw_class(panel: ExercisePanel, task) -> None:
+    _, panel.class_dir = imgui.input_text("class results folder", panel.class_dir)
+    imgui.same_line()
+    if imgui.small_button("Load"):
+        load_class(panel, panel.class_dir)
+    row = panel.class_rows.get(task.id)
+    if row is not None:
+        imgui.text_wrapped(row.text())
 
 
 def _draw_answer(state, panel: ExercisePanel, task, ts: TaskState, width: float) -> None:
