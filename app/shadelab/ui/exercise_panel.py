@@ -48,6 +48,7 @@ class ExercisePanel:
     uploaded: set[str] = field(default_factory=set)  # textures already sent (not per frame)
     class_dir: str = ""                              # teacher: the class's graded records
     class_rows: dict = field(default_factory=dict)   # task id -> grading.ClassRow
+    image_rects: dict = field(default_factory=dict)  # image name -> (x, y, scale) on screen
 
     def task_state(self, task) -> TaskState:
         return self.tasks.setdefault(task.id, TaskState())
@@ -122,6 +123,7 @@ def _show(state, name: str, image: np.ndarray, width: float):
         imgui.dummy(imgui.ImVec2(width, h * scale))
         return None
     origin = imgui.get_cursor_screen_pos()
+    panel_of(state).image_rects[name] = (origin.x, origin.y, scale)  # where a click lands
     imgui.image(imgui.ImTextureRef(texture.id), imgui.ImVec2(width, h * scale))
     if imgui.is_item_clicked():
         mouse = imgui.get_io().mouse_pos
