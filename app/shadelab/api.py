@@ -279,11 +279,16 @@ def save_preset(scene: Scene, path: str | Path) -> None:
     if not isinstance(scene, Scene):
         raise ShadeLabError(f"scene: expected a Scene (from load_preset), got "
                             f"{type(scene).__name__}")
-    save(scene, _check_path("path", path))
+    save(_scene(scene), _check_path("path", path))  # nothing a preset would refuse is saved
 
 
 def _scene(scene: Scene | str | Path) -> Scene:
+    """A preset name loaded, or a Scene checked as a preset would be (an edit in Python that
+    a preset would refuse — a 17th light, a zero scale, the eye on the target — is one line)."""
     if isinstance(scene, Scene):
+        from shadelab.scene.preset import check_scene
+
+        check_scene(scene, scene.name or "scene")
         return scene
     if isinstance(scene, (str, Path)):
         return load_preset(scene)

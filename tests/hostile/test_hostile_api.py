@@ -90,3 +90,49 @@ def test_every_public_function_checks_its_arguments(scene, call, named, tmp_path
     before = set(tmp_path.iterdir())
     _one_line(lambda: call(scene), named)
     assert set(tmp_path.iterdir()) == before  # nothing written
+
+
+def _lecture_edited(edit):
+    import copy
+
+    import shadelab
+
+    scene = shadelab.load_preset("lecture")
+    if edit == "eye on the target":
+        scene.camera.eye = scene.camera.target
+    elif edit == "17 lights":
+        scene.lights.extend(copy.deepcopy(scene.lights[0]) for _ in range(16))
+    elif edit == "zero scale":
+        scene.objects[1].scale = (0.0, 0.0, 0.0)
+    elif edit == "lights None":
+        scene.lights = None
+    elif edit == "a quad without vertices":
+        scene.objects[0].shape, scene.objects[0].vertices = "quad", []
+    elif edit == "an unknown material":
+        scene.objects[1].material = "nowhere"
+    return scene
+
+
+@pytest.mark.parametrize("edit, words", [
+    ("eye on the target", "camera.target': expected a point other than the eye"),
+    ("17 lights", "at most 16 lights, got 17"),
+    ("zero scale", "objects.1.scale': expected non-zero scales"),
+    ("lights None", "key 'lights': expected a list of Light, got NoneType"),
+    ("a quad without vertices", "objects.0.vertices': expected 4 points"),
+    ("an unknown material", "objects.1.material': expected a material name"),
+])
+@pytest.mark.parametrize("call", ["render", "probe", "save_preset"])
+def test_a_scene_edited_in_python_is_checked_as_a_preset(tmp_path, edit, words, call):
+    """Issue 24, class 10: these rendered silently (a near-black image, a light dropped) or
+    reached deep errors; the API now refuses what a preset would, in one line."""
+    import shadelab
+
+    scene = _lecture_edited(edit)
+    with pytest.raises(shadelab.ShadeLabError, match=words) as failure:
+        if call == "render":
+            shadelab.render(scene, size=16)
+        elif call == "probe":
+            shadelab.probe(scene, (8, 8), size=16)
+        else:
+            shadelab.save_preset(scene, tmp_path / "edited.toml")
+    assert "\n" not in str(failure.value) and not (tmp_path / "edited.toml").exists()

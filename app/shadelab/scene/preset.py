@@ -347,6 +347,31 @@ def estimated_triangles(obj: Object) -> int:
             "plane": 2 * obj.segments ** 2, "quad": 2 * obj.segments ** 2}.get(obj.shape, 0)
 
 
+def check_scene(scene: Scene, source: str = "scene") -> None:
+    """What a preset would refuse, for a scene edited in Python: its parts of the right kinds
+    (fields are validated at assignment) and the cross-table checks of :func:`_cross_check`
+    (material names, quad vertices, scales, light count and directions, camera)."""
+    from shadelab.scene.model import Camera, Material
+
+    parts = (("lights", list, Light), ("objects", list, Object))
+    for key, container, item in parts:
+        value = getattr(scene, key)
+        if not isinstance(value, container):
+            raise ShadeLabError(f"{source}: key '{key}': expected a list of {item.__name__}, "
+                                f"got {type(value).__name__}")
+        for i, entry in enumerate(value):
+            if not isinstance(entry, item):
+                raise ShadeLabError(f"{source}: key '{key}.{i}': expected a {item.__name__}, "
+                                    f"got {type(entry).__name__}")
+    if not isinstance(scene.materials, dict) or not all(
+            isinstance(k, str) and isinstance(v, Material) for k, v in scene.materials.items()):
+        raise ShadeLabError(f"{source}: key 'materials': expected a dict of name -> Material")
+    if not isinstance(scene.camera, Camera):
+        raise ShadeLabError(f"{source}: key 'camera': expected a Camera, "
+                            f"got {type(scene.camera).__name__}")
+    _cross_check(scene, source)
+
+
 def _cross_check(scene: Scene, source: str) -> None:
     """Checks that span tables: material references, required shape keys, light count."""
     limits.check(f"{source}: key 'objects'", len(scene.objects), limits.MAX_OBJECTS, "objects")
