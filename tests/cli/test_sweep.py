@@ -112,3 +112,42 @@ def test_ctrl_c_leaves_nothing_half_written(gl_ctx, tmp_path, monkeypatch):
                  "16x16", "-o", str(tmp_path / "kd.gif")]) == 130
     assert sorted(p.name for p in tmp_path.iterdir()) == ["kd.gif"]
     assert (tmp_path / "kd.gif").read_bytes() == b"the user's old file"
+
+
+def test_a_truncated_video_is_an_error_not_a_result(gl_ctx, tmp_path, capsys):
+    """On a full disk ffmpeg prints 'Error writing trailer' and exits 0, leaving a truncated
+    file that replaced the output (issue 24, class 11): the frames written are counted first."""
+    import os
+
+    from shadelab.cli.sweep import _check_video
+
+    good = tmp_path / "n.mp4"
+    assert main(["sweep", "lecture", "materials.plastic.n=1:100", "--frames", "3", "--size",
+                 "32x24", "-o", str(good)]) == 0
+    _check_video(good, good, 3)                     # complete: no error
+    cut = tmp_path / "cut.mp4"
+    data = good.read_bytes()
+    cut.write_bytes(data[: len(data) // 3])
+    with pytest.raises(OSError, match=r"not completely written \(\d of 3 frames"):
+        _check_video(cut, tmp_path / "out.mp4", 3)
+
+
+def test_a_killed_sweeps_partial_output_is_removed_by_the_next(gl_ctx, tmp_path):
+    """SIGKILL leaves the temporary output (no cleanup runs); the next sweep to the same
+    target removes the stale ones of its own name and keeps a fresh one (a live writer's)."""
+    import os
+    import time
+
+    from shadelab.cli.sweep import PARTIAL, STALE_S
+
+    stale = tmp_path / f".n{PARTIAL}dead.mp4"
+    fresh = tmp_path / f".n{PARTIAL}live.mp4"
+    other = tmp_path / ".notes.txt"
+    for path in (stale, fresh, other):
+        path.write_bytes(b"x")
+    old = time.time() - 2 * STALE_S
+    os.utime(stale, (old, old))
+    os.utime(other, (old, old))
+    assert main(["sweep", "lecture", "materials.plastic.n=1:100", "--frames", "2", "--size",
+                 "32x24", "-o", str(tmp_path / "n.mp4")]) == 0
+    assert not stale.exists() and fresh.exists() and other.exists()

@@ -121,6 +121,47 @@ def _output_kind(path: Path) -> str:
     return "png"
 
 
+PARTIAL = ".shadelab-partial-"  # in the temporary name of an output being written
+STALE_S = 120.0                  # a partial output untouched this long is a dead run's
+
+
+def _remove_stale_partials(out: Path) -> None:
+    """A sweep ended by SIGKILL (no cleanup runs) leaves its temporary output beside the
+    target; the next sweep to the same target removes those of its own name untouched for
+    STALE_S seconds (a live writer keeps its file fresh)."""
+    import shutil
+    import time
+
+    folder = out.resolve().parent
+    stem = out.name if out.suffix == "" else out.stem
+    for leftover in folder.glob(f".{stem}{PARTIAL}*"):
+        try:
+            if time.time() - leftover.stat().st_mtime < STALE_S:
+                continue
+            if leftover.is_dir():
+                shutil.rmtree(leftover, ignore_errors=True)
+            else:
+                leftover.unlink()
+        except OSError:
+            pass
+
+
+def _check_video(tmp: Path, out: Path, frames: int) -> None:
+    """ffmpeg exits 0 after 'Error writing trailer' on a full disk, leaving a truncated file:
+    count the frames it wrote before the file replaces ``out``."""
+    import errno
+
+    import imageio_ffmpeg
+
+    try:
+        written, _ = imageio_ffmpeg.count_frames_and_secs(str(tmp))
+    except Exception:  # noqa: BLE001 - an unreadable video is the same failure
+        written = 0
+    if written != frames:
+        raise OSError(errno.EIO, f"the video was not completely written ({written} of "
+                                 f"{frames} frames; is the disk full?)", str(out))
+
+
 def run(args: argparse.Namespace) -> int:
     import numpy as np
     from PIL import Image as PILImage
@@ -184,10 +225,11 @@ def run(args: argparse.Namespace) -> int:
             _caption(picture, f"{key} = {_label(value)}")
         return picture
 
+    _remove_stale_partials(out)
     if kind == "png":
-        tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}-", dir=out.resolve().parent))
+        tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}{PARTIAL}", dir=out.resolve().parent))
     else:
-        fd, name = tempfile.mkstemp(prefix=f".{out.stem}-", suffix=out.suffix,
+        fd, name = tempfile.mkstemp(prefix=f".{out.stem}{PARTIAL}", suffix=out.suffix,
                                     dir=out.resolve().parent)
         os.close(fd)
         tmp = Path(name)
@@ -219,6 +261,7 @@ def run(args: argparse.Namespace) -> int:
         if writer is not None:
             writer.close()
             writer = None
+            _check_video(tmp, out, len(values))
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(tmp, (0o777 if kind == "png" else 0o666) & ~umask)  # mkstemp made it 0600
