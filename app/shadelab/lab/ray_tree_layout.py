@@ -7,13 +7,13 @@ that add light, its contribution ``c`` to the pixel. The edge into each box carr
 the ray's kind, its own factor (kr for reflected, kt for refracted) and its weight ``w`` (the
 product of the factors from the pixel down).
 
-Layout: the leaves of the tree sit on a grid of slots (a shadow ray's is ``SHADOW_SLOT`` of
-the others'); a node spans the slots of its subtree's leaves (width from the subtree's leaf
+Layout: the leaves of the tree sit on a grid of slots (a shadow ray's narrower, wide enough
+for ``SHADOW_TEXT``); a node spans the slots of its subtree's leaves (width from the subtree's leaf
 count) and is centred over them, one row per
 tree level. Every row is three bands: the wires from the parents, the edge labels, the node
 boxes. Boxes of one band lie in disjoint slot ranges and bands do not share rows, so no two
 boxes overlap (:func:`overlapping` checks it pairwise). Text wraps to its slot; when the slot
-is too narrow for ``min_chars`` characters the whole diagram is laid out at that width and
+is too narrow for ``MIN_TEXT`` the whole diagram is laid out at that width and
 scaled down to fit (``Diagram.scale``, also the font scale to draw with).
 """
 
@@ -27,8 +27,10 @@ import numpy as np
 #: Digits of the contributions shown: their sum matches the pixel within half a unit of the
 #: last digit per node shown.
 DIGITS = 3
-#: A shadow ray's leaf slot, in leaf slots of the other rays (its text is short)
-SHADOW_SLOT = 0.7
+#: What a leaf slot holds on one line at least (else the diagram is scaled down)
+MIN_TEXT = ("reflected", "refracted", "background", "c=(0.000,")
+#: What a shadow ray's (narrower) leaf slot holds on one line at least
+SHADOW_TEXT = ("shadow", "L0 lit")
 
 
 @dataclass(frozen=True)
@@ -167,17 +169,19 @@ def _wrap(lines: Sequence[str], width: float, measure: Callable[[str], float]) -
 
 def layout(root, names: Sequence[str], width: float, *, char_w: float = 7.0,
            line_h: float = 14.0, measure: Callable[[str], float] | None = None,
-           min_chars: int = 10, pad: float = 4.0, wire_h: float | None = None,
+           min_text: Sequence[str] = MIN_TEXT, pad: float = 4.0, wire_h: float | None = None,
            pixel: tuple | None = None) -> Diagram:
     """The diagram of the tree ``root`` in ``width`` pixels.
 
     ``names``: object names by index (``scene.objects``); ``measure(text)`` a text's width in
     pixels at scale 1 (default ``len(text) * char_w``), ``line_h`` a line's height. Text wraps
-    to its leaf slot; if a slot would be narrower than ``min_chars`` characters the diagram is
+    to its leaf slot; if a slot would be narrower than the widest of ``min_text`` the diagram is
     laid out at that slot width and scaled by ``width / natural width``.
     """
     measure = measure or (lambda s: len(s) * char_w)
     wire_h = 1.2 * line_h if wire_h is None else wire_h
+    least = max(measure(t) for t in min_text) + 4 * pad       # a leaf slot's least width
+    shadow_slot = min(1.0, (max(measure(t) for t in SHADOW_TEXT) + 4 * pad) / least)
     nodes: list[DiagramNode] = []
     units: dict[int, float] = {}
     children: dict[int, list[int]] = {}
@@ -193,12 +197,12 @@ def layout(root, names: Sequence[str], width: float, *, char_w: float = 7.0,
         for child in node.children:
             children[index].append(len(nodes))
             below += visit(child, index, level + 1)
-        own = SHADOW_SLOT if node.kind == "shadow" else 1.0
+        own = shadow_slot if node.kind == "shadow" else 1.0
         units[index] = max(below, own)
         return units[index]
 
     total_units = visit(root, -1, 0)
-    slot = max(width / total_units, min_chars * measure("M") + 4 * pad)
+    slot = max(width / total_units, least)
     natural = slot * total_units
     scale = min(1.0, width / natural)
 

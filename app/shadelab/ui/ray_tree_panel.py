@@ -49,12 +49,14 @@ def draw_ray_tree_panel(state: AppState) -> bool:
                            "viewport (or click the Offline panel's Whitted image).")
         return False
     total = root.total()
-    imgui.text_wrapped(f"pixel {pixel} ({where}): {sum(1 for _ in root.flatten())} rays, "
-                       f"value ({total[0]:.3f}, {total[1]:.3f}, {total[2]:.3f}) = sum of c")
     width = max(imgui.get_content_region_avail().x - 4.0, 120.0)
     font_size = imgui.get_font_size()
     diagram = diagram_of(root, scene, pixel, width, measure=lambda s: imgui.calc_text_size(s).x,
                          line_h=imgui.get_text_line_height())
+    shrunk = f", text x{diagram.scale:.2f}: widen the window" if diagram.scale < 0.99 else ""
+    imgui.text_wrapped(f"pixel {pixel} ({where}): {sum(1 for _ in root.flatten())} rays, "
+                       f"value ({total[0]:.3f}, {total[1]:.3f}, {total[2]:.3f}) = sum of c"
+                       + shrunk)
     origin = imgui.get_cursor_screen_pos()
     imgui.invisible_button("##ray_tree_canvas", imgui.ImVec2(width, max(diagram.height, 1.0)))
     hovered = None
