@@ -26,7 +26,8 @@ SIZES = {"layout_1024": (1024, 768), "layout_1920": (1920, 1080)}
 DOCK_WINDOWS = ("Scene", "Lights", "Materials", "Objects", "Equation & probe", "Offline render")
 # every panel, for the content-width check (text carries no item id: only the window's content
 # size shows a line of text that runs past the right edge)
-ALL_PANELS = DOCK_WINDOWS + ("Algorithms", "Studies", "Failure gallery", "Hemicube & F")
+ALL_PANELS = DOCK_WINDOWS + ("Algorithms", "Studies", "Failure gallery", "Hemicube & F",
+                             "Ray tree")
 
 
 @pytest.fixture(scope="module")

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 PANEL_LABELS = ("Scene", "Lights", "Materials", "Objects", "Viewport", "Equation & probe",
                 "Studies", "Failure gallery", "Offline render", "Algorithms", "Hemicube & F",
-                "Exercise")
+                "Exercise", "Ray tree")
 
 
 def unknown_panel(focus: str) -> str | None:

@@ -44,6 +44,8 @@ class PipelineView:
     ray_tree: object = None
     ray_tree_pixel: tuple | None = None
     tree_depth: int = 99                 # ray-tree generations shown
+    tree_hover: object = None            # the RayNode hovered in the Ray tree window
+    tree_key: object = None              # what the ray tree depends on (ui/pipelines.tree_key)
     raster_key: dict = field(default_factory=dict)
     warm_started: bool = False
     record: object = None                # JobRecord of the viewport's current job

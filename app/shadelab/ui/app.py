@@ -39,6 +39,7 @@ from shadelab.ui import (
     pipelines,
     presenter,
     radiosity_view,
+    ray_tree_panel,
     scene_panel,
 )
 from shadelab.ui.exercise_panel import draw_exercise_panel
@@ -476,6 +477,7 @@ def _docking(viewer: Viewer) -> hello_imgui.DockingParams:
         window("Algorithms", "LeftSpace", p(draw_algorithms_panel)),
         window("Hemicube & F", "RightSpace", p(radiosity_view.draw_panel)),
         window("Exercise", "RightSpace", p(draw_exercise_panel)),
+        window("Ray tree", "RightSpace", p(ray_tree_panel.draw_ray_tree_panel)),
     ]
     for w in params.dockable_windows:
         # llvmpipe is fill-bound: the window clear (same color) replaces every panel's

@@ -37,6 +37,7 @@ from shadelab.lab.state import AppState
 from shadelab.scene.preset import clone_scene
 
 OFFLINE = {name: pipeline_jobs.pipeline_job(name) for name in OFFLINE_NAMES}
+HOVER_COLOR = 0xFF00FFFF   # the ray hovered in the Ray tree window
 RAY_COLORS = {"primary": 0xFFFFFFFF, "reflected": 0xFF30D0FF, "refracted": 0xFFFFB040,
               "shadow": 0xFF40FF40, "blocked": 0xFF4040FF}   # ImGui ABGR
 SHOOTER_COLOR = (1.0, 0.9, 0.1)
@@ -91,6 +92,12 @@ def job_key(state: AppState, name: str, size: tuple[int, int]) -> tuple:
     return (name, id(scene), state.scene_version, scene.version, size, spp)
 
 
+def tree_key(scene) -> tuple:
+    """What a picked ray tree depends on: the scene (which one) and its objects, materials,
+    lights and ray-tracing settings, not the camera (the tree is in world space)."""
+    return (scene.base_dir, scene.edit_key("objects", "materials", "lights", "raytrace"))
+
+
 def scene_for(state: AppState, name: str):
     scene = clone_scene(state.scene)
     if name == "pathtrace":
@@ -106,7 +113,10 @@ def poll(state: AppState, name: str, size: tuple[int, int]) -> None:
     if key != view.key:
         view.key = key
         view.wanted = (name, scene_for(state, name), size)
-        view.ray_tree = None
+        if view.tree_key != tree_key(state.scene):
+            # the tree is in world space: a camera move or a resize keeps it, an edit of what
+            # the rays hit or the tracer's settings clears it
+            view.ray_tree = view.ray_tree_pixel = view.tree_hover = view.tree_key = None
         # no wait: the new job starts once this one stops; a warm-up stops at its next stage
         # (one renderer's kernels) and is never killed mid-compile
         if view.name == "warm-up":
@@ -317,6 +327,8 @@ def pick_ray_tree(state: AppState, name: str, pixel, display_size) -> None:
 
         view.ray_tree = trace_pixel_tree(view.job_scene, (w, h), x, y)
         view.ray_tree_pixel = (x, y)
+        view.tree_key = tree_key(view.job_scene)   # a copy has its original's edit key
+        view.tree_hover = None
         view.tree_depth = 99
     except Exception as exc:  # shown in the app; the session goes on
         state.error = f"ray tree of pixel {(x, y)}: {exc}"
@@ -380,3 +392,7 @@ def draw_ray_tree(state: AppState, draw_list, origin, display_size) -> None:
             draw_list.add_circle_filled(b, thick + 2, RAY_COLORS[kind])
             label(draw_list, imgui.ImVec2(b.x + 8, b.y - 8),
                    f"{node.kind} d{node.depth}: {object_label(scene, node.object)}")
+        if node is view.tree_hover:   # hovered in the Ray tree window
+            if front[0]:
+                draw_list.add_line(a, b, HOVER_COLOR, 2.5 * thick)
+            draw_list.add_circle(b, 3 * thick, HOVER_COLOR, 0, thick)
