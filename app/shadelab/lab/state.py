@@ -156,6 +156,8 @@ class LessonState:
 
     lesson: LessonRun | None = None
     focus_request: str = ""           # panels to bring to the front next frame (a,b,...)
+    prefetch: object = None           # shadelab.lab.prefetch.Prefetch: the next step's job
+    prefetch_enabled: bool = True     # (--no-prefetch: off, to measure without it)
 
 
 # AppState's sub-states by their attribute names: ``state.view.compare``, ``state.probe.pixel``,

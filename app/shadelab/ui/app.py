@@ -190,13 +190,17 @@ class Viewer:
         pipeline_view = self.state.view.pipeline_view
         if pipeline_view is not None and pipeline_view.runner is not None:
             pipeline_view.runner.shutdown()
+        prefetched = self.state.walk.prefetch
+        if prefetched is not None and prefetched.runner is not None:
+            prefetched.runner.shutdown()
         if self.state.studies.run is not None:
             self.state.studies.run.shutdown()
         if self.options.autosave:
             self.autosave(self.state, force=True)
         if self.options.bench_json:
             self.recorder.write(self.options.bench_json, self.options.window_size,
-                                pipelines.bench_report(self.state))  # jobs: first_image_s...
+                                pipelines.bench_report(self.state)  # jobs: first_image_s...
+                                | self.followups.bench_extra())
         if self.gpu is not None:
             self.gpu.release()
             self.gpu = None
