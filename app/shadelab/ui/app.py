@@ -219,6 +219,9 @@ class Viewer:
         if size != state.view.viewport_size and state.probe.pixel is not None:
             state.probe.requested = True  # the same pixel shows another point now
         state.view.viewport_size = size
+        if state.walk.lesson is not None:   # the next step's viewport (its prefetch's size)
+            state.walk.next_size = (size[0], max(int(avail.y - presenter.next_step_band(
+                state, avail.x)) - 4, 16))
         if state.view.compare:
             compare_view.draw_compare(self, size)
         else:

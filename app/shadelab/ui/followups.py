@@ -75,6 +75,7 @@ class FollowUps:
     study_done_at: int = 0             # frame the --study run ended
     page_down_s: float | None = None   # bench: when the scripted PageDown happened
     settled_at: int = 0                # bench: frame the step (and its prefetch) settled
+    page_down_at: int = 0              # bench: frame of that PageDown
 
     def start(self, state: AppState, dockable_windows: list) -> None:
         """Once the window (and its GL) is up: the start-up requests of the command line."""
@@ -107,8 +108,9 @@ class FollowUps:
                                          or state.offline.version != runner.version)
         waiting = waiting or bool((options.pipeline or lesson_offline(state))
                                   and pipelines.busy(state))
-        if options.page_down and self.page_down_s is None:
-            waiting = not self.press_page_down(state)
+        if options.page_down and (self.page_down_s is None or state.frame < self.page_down_at + 3):
+            self.press_page_down(state)
+            waiting = True    # (after it: the new step's job is polled on the next frame)
         if state.studies.run is not None:
             state.studies.run.poll()  # also while the Studies tab is hidden
             if options.study and not self.study_done_at and not state.studies.run.running:
@@ -125,7 +127,10 @@ class FollowUps:
 
         from shadelab.lab.lesson import next_step
 
-        settled = state.frame >= 10 and not pipelines.busy(state) and prefetch_settled(state)
+        if self.page_down_s is not None:
+            return True
+        settled = state.frame >= 10 and not pipelines.busy(state) \
+            and not (lesson_offline(state) and state.frame < 5) and prefetch_settled(state)
         if not settled:
             self.settled_at = 0
             return False
@@ -134,6 +139,7 @@ class FollowUps:
         if state.frame < self.settled_at + 5:
             return False
         self.page_down_s = pipelines.since_start(time.perf_counter())
+        self.page_down_at = state.frame
         next_step(state)
         return True
 

@@ -47,9 +47,11 @@ def draw(viewer: ViewportHost, display_size: tuple[int, int]) -> bool:
             and state.view.wipe_pipeline != name)
     scale = state.view.render_scale
     size = (max(int(display_size[0] * scale), 8), max(int(display_size[1] * scale), 8))
+    ahead = state.walk.next_size or display_size     # the next lesson step's viewport
+    next_size = (max(int(ahead[0] * scale), 8), max(int(ahead[1] * scale), 8))
     if name not in OFFLINE and not wipe:
         if state.frame >= 3:    # the next lesson step's offline job, ahead of time
-            prefetch_tick(state, size)
+            prefetch_tick(state, next_size)
         if view.runner is not None and view.runner.running and view.name in OFFLINE:
             view.runner.cancel()
         view.key = None
@@ -60,7 +62,7 @@ def draw(viewer: ViewportHost, display_size: tuple[int, int]) -> bool:
     offline = [n for n in (name, other) if n in OFFLINE]
     if offline:
         poll(state, offline[0], size)      # (adopts a prefetched job first: then the tick)
-        prefetch_tick(state, size)
+        prefetch_tick(state, next_size)
         viewer.gpu.flush_uploads(state.gpu)  # a new image: on its texture this frame
         if view.runner.running:
             view.frame_times.append(time.perf_counter())
