@@ -130,3 +130,15 @@ def test_go_to_records_the_loaded_scene():
     assert unedited(state.walk.lesson, state)
     state.scene.render.exposure = state.scene.render.exposure + 0.5
     assert not unedited(state.walk.lesson, state)
+
+
+def test_a_new_prefetch_waits_for_the_dropped_one_to_stop():
+    run = lesson("phong", "raytrace", "pathtrace")
+    run.index = 0
+    pf, runner = Prefetch(), FakeRunner()
+    pf.runner = runner
+    runner.running = True          # a cancelled job has not stopped yet
+    wanted = (step_key(run, 1, "raytrace", (64, 48), 4), 1, "raytrace", (64, 48))
+    assert not pf.tick(wanted, False, starter(pf, runner))
+    runner.running = False
+    assert pf.tick(wanted, False, starter(pf, runner))

@@ -63,7 +63,8 @@ class Prefetch:
         if self.key is not None and (wanted is None or self.key != wanted[0]
                                      or (current_busy and self.running)):
             self.drop()
-        if not self.enabled or wanted is None or current_busy or self.key is not None:
+        if not self.enabled or wanted is None or current_busy or self.key is not None \
+                or self.running:     # (a dropped job still stopping: start on a later frame)
             return False
         self.key, self.index = wanted[0], wanted[1]
         start(wanted)

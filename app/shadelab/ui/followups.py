@@ -129,7 +129,9 @@ class FollowUps:
 
         if self.page_down_s is not None:
             return True
-        settled = state.frame >= 10 and not pipelines.busy(state) \
+        view = state.view.pipeline_view
+        idle = view is None or view.runner is None or not view.runner.running  # (warm-up)
+        settled = idle and state.frame >= 10 and not pipelines.busy(state) \
             and not (lesson_offline(state) and state.frame < 5) and prefetch_settled(state)
         if not settled:
             self.settled_at = 0
