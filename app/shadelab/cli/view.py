@@ -63,6 +63,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--help-overlay", action="store_true", help="show the shortcut help")
     p.add_argument("--no-autosave", action="store_true", help="do not write the session")
     p.add_argument("--bench-json", help=argparse.SUPPRESS)
+    p.add_argument("--bench-page-down", action="store_true", help=argparse.SUPPRESS)
+    p.add_argument("--no-prefetch", action="store_true",
+                   help="with --lesson: do not render the next step's offline pipeline "
+                        "ahead of time")
     p.set_defaults(run=run_view)
 
 
@@ -275,6 +279,7 @@ def run_view(args: argparse.Namespace) -> int:
         from shadelab.lab.lesson import go_to
 
         state.walk.lesson = run
+        state.walk.prefetch_enabled = not args.no_prefetch
         go_to(state, args.step - 1)
     state.view.msaa = args.msaa
     if exercise is not None:
@@ -287,6 +292,6 @@ def run_view(args: argparse.Namespace) -> int:
                             show_radiosity=args.show_radiosity, ray_tree=ray_tree,
                             focus=args.focus or "", study=args.study or "",
                             gallery=args.gallery or "", pipeline=args.pipeline or "",
-                            fullscreen=args.fullscreen,
+                            fullscreen=args.fullscreen, page_down=args.bench_page_down,
                             maximized=args.window is None and not args.fullscreen)
     return run_viewer(state, options)

@@ -60,6 +60,7 @@ def go_to(state, index: int) -> bool:
         setattr(state.view, attr, name in step.show)
     if step.focus:
         state.walk.focus_request = step.focus
+    run.loaded = (state.scene_version, state.scene.version)   # prefetch key: till an edit
     state.error, state.status = "", f"lesson step {index + 1}/{len(run.lesson.steps)}: " \
                                      f"{step.title}"
     return True

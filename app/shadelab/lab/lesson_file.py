@@ -154,6 +154,7 @@ class LessonRun:
 
     lesson: Lesson
     index: int = -1
+    loaded: tuple | None = None      # (scene_version, scene.version) just after go_to loaded it
 
     @property
     def step(self) -> Step | None:

@@ -156,6 +156,9 @@ class LessonState:
 
     lesson: LessonRun | None = None
     focus_request: str = ""           # panels to bring to the front next frame (a,b,...)
+    prefetch: object = None           # shadelab.lab.prefetch.Prefetch: the next step's job
+    prefetch_enabled: bool = True     # (--no-prefetch: off, to measure without it)
+    next_size: tuple | None = None    # the viewport's (w, h) at the next step (its caption)
 
 
 # AppState's sub-states by their attribute names: ``state.view.compare``, ``state.probe.pixel``,

@@ -191,13 +191,17 @@ class Viewer:
         pipeline_view = self.state.view.pipeline_view
         if pipeline_view is not None and pipeline_view.runner is not None:
             pipeline_view.runner.shutdown()
+        prefetched = self.state.walk.prefetch
+        if prefetched is not None and prefetched.runner is not None:
+            prefetched.runner.shutdown()
         if self.state.studies.run is not None:
             self.state.studies.run.shutdown()
         if self.options.autosave:
             self.autosave(self.state, force=True)
         if self.options.bench_json:
             self.recorder.write(self.options.bench_json, self.options.window_size,
-                                pipelines.bench_report(self.state))  # jobs: first_image_s...
+                                pipelines.bench_report(self.state)  # jobs: first_image_s...
+                                | self.followups.bench_extra())
         if self.gpu is not None:
             self.gpu.release()
             self.gpu = None
@@ -216,6 +220,9 @@ class Viewer:
         if size != state.view.viewport_size and state.probe.pixel is not None:
             state.probe.requested = True  # the same pixel shows another point now
         state.view.viewport_size = size
+        if state.walk.lesson is not None:   # the next step's viewport (its prefetch's size)
+            state.walk.next_size = (size[0], max(int(avail.y - presenter.next_step_band(
+                state, avail.x)) - 4, 16))
         if state.view.compare:
             compare_view.draw_compare(self, size)
         else:

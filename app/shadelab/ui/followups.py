@@ -35,6 +35,24 @@ class ViewerOptions:
     maximized: bool = False               # open maximized (no --window given)
     pipeline: str = ""                    # viewport pipeline at start (shadelab.ui.pipelines)
     test_function: Callable | None = None  # immapp.testing test body (GUI tests)
+    page_down: bool = False               # bench: PageDown once the lesson step has settled
+
+
+def lesson_offline(state: AppState) -> bool:
+    """A lesson's current step shows an offline pipeline (``--frames`` counts after its job)."""
+    run = state.walk.lesson
+    return run is not None and run.step is not None and run.step.pipeline in pipelines.OFFLINE
+
+
+def prefetch_settled(state: AppState) -> bool:
+    """The next step's prefetch (when on and wanted) has finished."""
+    from shadelab.lab.prefetch import next_offline
+
+    if not state.walk.prefetch_enabled or next_offline(state.walk.lesson,
+                                                       pipelines.OFFLINE) is None:
+        return True
+    pf = state.walk.prefetch
+    return pf is not None and pf.record is not None and pf.record.done_s is not None
 
 
 def open_gallery_case(state: AppState, name: str) -> None:
@@ -55,6 +73,9 @@ class FollowUps:
     options: ViewerOptions
     job_followed_up: bool = False
     study_done_at: int = 0             # frame the --study run ended
+    page_down_s: float | None = None   # bench: when the scripted PageDown happened
+    settled_at: int = 0                # bench: frame the step (and its prefetch) settled
+    page_down_at: int = 0              # bench: frame of that PageDown
 
     def start(self, state: AppState, dockable_windows: list) -> None:
         """Once the window (and its GL) is up: the start-up requests of the command line."""
@@ -85,7 +106,11 @@ class FollowUps:
         runner = state.offline.runner
         waiting = bool(options.job) and (runner.running or not runner.started
                                          or state.offline.version != runner.version)
-        waiting = waiting or bool(options.pipeline and pipelines.busy(state))
+        waiting = waiting or bool((options.pipeline or lesson_offline(state))
+                                  and pipelines.busy(state))
+        if options.page_down and (self.page_down_s is None or state.frame < self.page_down_at + 3):
+            self.press_page_down(state)
+            waiting = True    # (after it: the new step's job is polled on the next frame)
         if state.studies.run is not None:
             state.studies.run.poll()  # also while the Studies tab is hidden
             if options.study and not self.study_done_at and not state.studies.run.running:
@@ -94,6 +119,34 @@ class FollowUps:
                 state.studies.run.running
                 or state.frame < self.study_done_at + min(options.frames, 10)))
         return waiting
+
+    def press_page_down(self, state: AppState) -> bool:
+        """Bench (``--bench-page-down``): PageDown once the step's job and the next step's
+        prefetch are done and a few frames have passed; True once pressed."""
+        import time
+
+        from shadelab.lab.lesson import next_step
+
+        if self.page_down_s is not None:
+            return True
+        view = state.view.pipeline_view
+        idle = view is None or view.runner is None or not view.runner.running  # (warm-up)
+        settled = idle and state.frame >= 10 and not pipelines.busy(state) \
+            and not (lesson_offline(state) and state.frame < 5) and prefetch_settled(state)
+        if not settled:
+            self.settled_at = 0
+            return False
+        if not self.settled_at:
+            self.settled_at = state.frame
+        if state.frame < self.settled_at + 5:
+            return False
+        self.page_down_s = pipelines.since_start(time.perf_counter())
+        self.page_down_at = state.frame
+        next_step(state)
+        return True
+
+    def bench_extra(self) -> dict:
+        return {} if self.page_down_s is None else {"page_down_s": self.page_down_s}
 
     def end_frame(self, state: AppState) -> bool:
         """Once a frame: the after-job requests; True when ``--frames`` says quit now."""

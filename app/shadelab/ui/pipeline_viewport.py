@@ -25,6 +25,7 @@ from shadelab.ui.pipelines import (
     patch_edges,
     pick_ray_tree,
     poll,
+    prefetch_tick,
     shooter_lines,
     status_line,
     sync,
@@ -44,19 +45,24 @@ def draw(viewer: ViewportHost, display_size: tuple[int, int]) -> bool:
     name = current(state)
     wipe = (state.view.wipe and state.view.wipe_pipeline in PIPELINES
             and state.view.wipe_pipeline != name)
+    scale = state.view.render_scale
+    size = (max(int(display_size[0] * scale), 8), max(int(display_size[1] * scale), 8))
+    ahead = state.walk.next_size or display_size     # the next lesson step's viewport
+    next_size = (max(int(ahead[0] * scale), 8), max(int(ahead[1] * scale), 8))
     if name not in OFFLINE and not wipe:
+        if state.frame >= 3:    # the next lesson step's offline job, ahead of time
+            prefetch_tick(state, next_size)
         if view.runner is not None and view.runner.running and view.name in OFFLINE:
             view.runner.cancel()
         view.key = None
         return False
-    scale = state.view.render_scale
-    size = (max(int(display_size[0] * scale), 8), max(int(display_size[1] * scale), 8))
     if state.frame < 3:     # the dock layout settles over the first frames: no job at 16x16
         return True
     other = state.view.wipe_pipeline if wipe else None
     offline = [n for n in (name, other) if n in OFFLINE]
     if offline:
-        poll(state, offline[0], size)
+        poll(state, offline[0], size)      # (adopts a prefetched job first: then the tick)
+        prefetch_tick(state, next_size)
         viewer.gpu.flush_uploads(state.gpu)  # a new image: on its texture this frame
         if view.runner.running:
             view.frame_times.append(time.perf_counter())

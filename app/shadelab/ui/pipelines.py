@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 from imgui_bundle import imgui
 
-from shadelab.lab import pipeline_jobs
+from shadelab.lab import pipeline_jobs, prefetch
 from shadelab.lab.pipeline_view import (  # noqa: F401  (the viewer reads them here too)
     LABELS,
     OFFLINE_NAMES,
@@ -72,12 +72,14 @@ class JobRecord:
     first_image_s: float | None = None
     done_s: float | None = None
     reused_form_factors: bool | None = None
+    prefetched: bool | None = None      # adopted from the lesson's prefetch (lab/prefetch.py)
 
     def as_dict(self) -> dict:
         return {"name": self.name, "size": list(self.size), "started_s": self.started_s,
                 "first_image_s": self.first_image_s, "done_s": self.done_s,
                 **({} if self.reused_form_factors is None
-                   else {"form_factors_reused": self.reused_form_factors})}
+                   else {"form_factors_reused": self.reused_form_factors}),
+                **({} if self.prefetched is None else {"prefetched": self.prefetched})}
 
 
 def job_key(state: AppState, name: str, size: tuple[int, int]) -> tuple:
@@ -112,11 +114,14 @@ def poll(state: AppState, name: str, size: tuple[int, int]) -> None:
     key = job_key(state, name, size)
     if key != view.key:
         view.key = key
-        view.wanted = (name, scene_for(state, name), size)
         if view.tree_key != tree_key(state.scene):
             # the tree is in world space: a camera move or a resize keeps it, an edit of what
             # the rays hit or the tracer's settings clears it
             view.ray_tree = view.ray_tree_pixel = view.tree_hover = view.tree_key = None
+        if _adopt_prefetch(state, name, size):
+            _take(state)
+            return
+        view.wanted = (name, scene_for(state, name), size)
         # no wait: the new job starts once this one stops; a warm-up stops at its next stage
         # (one renderer's kernels) and is never killed mid-compile
         if view.name == "warm-up":
@@ -127,6 +132,88 @@ def poll(state: AppState, name: str, size: tuple[int, int]) -> None:
         _start(state, *view.wanted)
         view.wanted = None
     _take(state)
+
+
+def _prefetch_key(state: AppState, index: int, name: str, size) -> tuple:
+    return prefetch.step_key(state.walk.lesson, index, name, size, state.offline.spp)
+
+
+def _adopt_prefetch(state: AppState, name: str, size) -> bool:
+    """The lesson step just arrived unedited and its job was prefetched: the viewport takes
+    that runner, finished or still refining (its own idle runner goes to the prefetch)."""
+    run, pf = state.walk.lesson, state.walk.prefetch
+    if pf is None or pf.key is None or not prefetch.unedited(run, state):
+        return False
+    if run.step is None or run.step.pipeline != name or view_of(state).step_mode:
+        return False
+    view = view_of(state)
+    scene, job_size = pf.scene, pf.size
+    old = view.runner
+    runner = pf.take(_prefetch_key(state, run.index, name, size), give_back=old)
+    if runner is None:
+        return False
+    if old is not None:
+        old.cancel()
+    if view.record is not None and view.record.done_s is None and old is not None:
+        view.record.done_s = since_start(old.finished or time.perf_counter())
+    view.runner, view.wanted = runner, None
+    view.name, view.job_scene, view.job_size = name, scene, job_size
+    view.version = -1
+    view.record = JobRecord(f"viewport {name}", tuple(size), since_start(time.perf_counter()),
+                            prefetched=True)
+    view.log.append(view.record)
+    view.stats = {}
+    return True
+
+
+def prefetch_tick(state: AppState, size: tuple[int, int]) -> None:
+    """Once a frame with a lesson open: render the next step's offline pipeline ahead of
+    time when the current step is settled; drop a prefetch that no longer matches."""
+    run = state.walk.lesson
+    pf = state.walk.prefetch
+    if run is None and pf is None:
+        return
+    if pf is None:
+        pf = state.walk.prefetch = prefetch.Prefetch()
+    pf.enabled = state.walk.prefetch_enabled
+    nxt = prefetch.next_offline(run, OFFLINE)
+    wanted = None
+    if nxt is not None:
+        index, name = nxt
+        wanted = (_prefetch_key(state, index, name, size), index, name, size)
+    current_busy = current(state) in OFFLINE and busy(state)
+    pf.tick(wanted, current_busy, lambda w: _start_prefetch(state, pf, *w[1:]))
+    record, runner = pf.record, pf.runner
+    if record is not None and runner is not None and pf.key is not None:
+        latest, _ = runner.snapshot()
+        if record.first_image_s is None and latest is not None and (
+                latest.image is not None or "soup" in (latest.stats or {})):
+            record.first_image_s = since_start(time.perf_counter())
+        if record.done_s is None and runner.started and not runner.running:
+            record.done_s = since_start(runner.finished or time.perf_counter())
+
+
+def _start_prefetch(state: AppState, pf, index: int, name: str, size) -> None:
+    from shadelab.lab.jobs import JobRunner
+    from shadelab.lab.lesson_file import step_scene
+
+    step = state.walk.lesson.lesson.steps[index]
+    try:
+        scene = step_scene(step)
+    except Exception as exc:   # go_to will say it in words when the step is reached
+        pf.key = None
+        state.error = f"lesson step {index + 1}: {exc}"
+        return
+    if name == "pathtrace":
+        scene.raytrace.spp = max(int(state.offline.spp), 1)
+    if pf.runner is None:
+        pf.runner = JobRunner()
+    pf.scene, pf.size = scene, tuple(size)
+    factory = OFFLINE[name]
+    pf.record = JobRecord(f"prefetch {name} (step {index + 1})", tuple(size),
+                          since_start(time.perf_counter()))
+    view_of(state).log.append(pf.record)
+    pf.runner.start(name, lambda: factory(scene, size), call=(factory, scene, size))
 
 
 def _start(state: AppState, name: str, scene, size) -> None:
@@ -172,8 +259,9 @@ def _take(state: AppState) -> None:
     latest, version = view.runner.snapshot()
     record = view.record
     if record is not None and record.done_s is None and view.runner.started \
-            and not view.runner.running:
-        record.done_s = since_start(view.runner.finished or time.perf_counter())
+            and not view.runner.running:   # (an adopted prefetch may have finished before)
+        record.done_s = max(record.started_s,
+                            since_start(view.runner.finished or time.perf_counter()))
     if latest is None or version == view.version:
         return
     view.version = version

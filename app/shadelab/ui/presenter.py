@@ -266,6 +266,19 @@ def caption_band(state: AppState, width: float) -> float:
     return height
 
 
+def next_step_band(state: AppState, width: float) -> float:
+    """The caption band the lesson's next step will keep (its prefetch renders at the size the
+    viewport will have then); the current band where there is no next step."""
+    run = state.walk.lesson
+    if run is None or run.step is None or run.index + 1 >= len(run.lesson.steps):
+        return caption_band(state, width)
+    from shadelab.lab.lesson_file import LessonRun
+
+    text = LessonRun(run.lesson, run.index + 1).caption()
+    height = caption_height(text, width, caption_scale(state))
+    return height + imgui.get_frame_height_with_spacing() if height else height
+
+
 LESSON_BUTTONS = ("< Prev (PgUp)", "Next > (PgDn)")
 
 
