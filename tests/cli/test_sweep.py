@@ -117,7 +117,6 @@ def test_ctrl_c_leaves_nothing_half_written(gl_ctx, tmp_path, monkeypatch):
 def test_a_truncated_video_is_an_error_not_a_result(gl_ctx, tmp_path, capsys):
     """On a full disk ffmpeg prints 'Error writing trailer' and exits 0, leaving a truncated
     file that replaced the output (issue 24, class 11): the frames written are counted first."""
-    import os
 
     from shadelab.cli.sweep import _check_video
 
