@@ -236,8 +236,10 @@ def _override_items(overrides: Mapping[str, Any] | Sequence[str] | None) -> list
             if not isinstance(key, str):
                 raise ShadeLabError(f"overrides: key {key!r}: expected a dotted key string")
             try:
+                if isinstance(value, Mapping) or value is None:  # a table, not a value
+                    raise TypeError
                 literal = tomli_w.dumps({"v": value}).split("=", 1)[1].strip()
-            except TypeError:
+            except (TypeError, ValueError, IndexError):
                 raise ShadeLabError(f"overrides '{key}': cannot use a {type(value).__name__} "
                                     "(expected a number, bool, string or list)") from None
             items.append(f"{key}={literal}")
