@@ -464,6 +464,14 @@ def test_ctrl_c_exits_130_and_leaves_no_file(tmp_path):
 
     light = GOOD.replace('kd = 0.5', 'kd = 0.5\nemission = [1.0, 1.0, 1.0]')
     out = tmp_path / "x.png"
+    # The path tracer's kernels compiled first (the test run's own numba cache starts empty
+    # in a fresh clone): a Ctrl+C that lands in numba's compiler waits for it, which took
+    # longer than this test's 30 s on a loaded 2-core CI machine
+    warm = subprocess.run([sys.executable, "-m", "shadelab", "pathtrace", _preset(tmp_path, light),
+                           "-o", str(tmp_path / "warm.png"), "--size", "8x8", "--spp", "1"],
+                          capture_output=True, text=True, timeout=600)
+    assert warm.returncode == 0, warm.stderr
+    (tmp_path / "warm.png").unlink()
     proc = subprocess.Popen([sys.executable, "-m", "shadelab", "pathtrace",
                              _preset(tmp_path, light), "-o", str(out), "--npy",
                              str(tmp_path / "x.npy"), "--size", "256x256", "--spp", "4000"],
