@@ -3,10 +3,12 @@
 One driver, two ways to watch it:
 
 * :meth:`RadiosityPipeline.run` (``shadelab.render``, ``shadelab radiosity``, the Offline
-  panel): :func:`shadelab.radiosity.solution.iter_radiosity`, adaptive meshing by default; the
+  panel): :func:`shadelab.radiosity.solution.iter_radiosity`, the scene's
+  ``radiosity.meshing`` (discontinuity meshing by default); the
   last step's ``stats["solution"]`` is the :class:`RadiositySolution`, drawn by
   :meth:`RadiosityPipeline.image` (the GL program, or CPU rays with ``display="cpu"``).
-* :meth:`RadiosityPipeline.viewport_job` (the viewer): uniform patches shot by shot
+* :meth:`RadiosityPipeline.viewport_job` (the viewer): the scene's patches (uniform for
+  "adaptive": no solve-and-split rounds while shooting) shot by shot
   (progressive refinement), the display triangles (``stats["soup"]``) after each chunk of shots
   with the patch that shot last; the GPU draws them under the live camera. Patches and
   form-factor rows stay in the worker between jobs, so a material or emission edit re-solves
@@ -53,7 +55,7 @@ class RadiosityPipeline(BasePipeline):
 
     def run(self, scene: Scene, size: tuple[int, int] | None = None,
             patches: int | None = None, form_factors: str | None = None,
-            solver: str | None = None, adaptive: bool = True, meshing: str = "uniform",
+            solver: str | None = None, adaptive: bool = True, meshing: str | None = None,
             gpu: bool = False, display: str = "gl") -> Iterator[Progress]:
         """``gpu``: hemicube form factors on the GL hemicube; ``size``: CPU images on the way
         (None: none, as the CLI and shadelab.render do; they draw the result with GL)."""
@@ -106,7 +108,10 @@ def radiosity_key(scene: Scene) -> str:
     objects = [(o.shape, o.material, o.path, o.radius, o.minor_radius, o.height, o.extents,
                 o.size, tuple(map(tuple, o.vertices)), o.subdivisions, o.sections, o.segments,
                 o.translate, o.rotate, o.scale) for o in scene.objects]
-    return repr((objects, scene.base_dir, s.patches, ff_method(scene), s.hemicube_resolution))
+    emitters = sorted(name for name, m in scene.materials.items() if max(m.emission) > 0.0)
+    meshing = (s.meshing, emitters) if s.meshing == "discontinuity" else s.meshing
+    return repr((objects, scene.base_dir, s.patches, meshing, ff_method(scene),
+                 s.hemicube_resolution))
 
 
 def ff_method(scene: Scene) -> str:
@@ -143,7 +148,12 @@ def pipeline_radiosity(scene: Scene, size: tuple[int, int] | None = None,
     from shadelab.radiosity import display
     from shadelab.radiosity.formfactors import FormFactors
     from shadelab.radiosity.patches import check_count
-    from shadelab.radiosity.solution import base_patches, check_scene, solver_steps
+    from shadelab.radiosity.solution import (
+        base_patches,
+        check_scene,
+        resolve_meshing,
+        solver_steps,
+    )
 
     settings = scene.radiosity
     check_count(settings.patches, "radiosity.patches")
@@ -154,7 +164,8 @@ def pipeline_radiosity(scene: Scene, size: tuple[int, int] | None = None,
     reused = cached is not None
     if cached is None:
         yield Progress(None, 0.0, "meshing", {"unit": "patches"})
-        patches = base_patches(scene, settings.patches, "uniform")
+        meshing = resolve_meshing(scene, settings.meshing, adaptive=False)
+        patches = base_patches(scene, settings.patches, meshing)
         ff = FormFactors(patches, ff_method(scene), settings.hemicube_resolution)
         cached = (patches, ff, f"ff-{time.time_ns()}")
         _RADIOSITY_CACHE.clear()  # one geometry at a time: the rows can be large
