@@ -7,8 +7,8 @@ One driver, two ways to watch it:
   ``radiosity.meshing`` (discontinuity meshing by default); the
   last step's ``stats["solution"]`` is the :class:`RadiositySolution`, drawn by
   :meth:`RadiosityPipeline.image` (the GL program, or CPU rays with ``display="cpu"``).
-* :meth:`RadiosityPipeline.viewport_job` (the viewer): the scene's patches (uniform for
-  "adaptive": no solve-and-split rounds while shooting) shot by shot
+* :meth:`RadiosityPipeline.viewport_job` (the viewer): uniform patches (whatever
+  ``radiosity.meshing`` says: the Hemicube & F window numbers the same grid) shot by shot
   (progressive refinement), the display triangles (``stats["soup"]``) after each chunk of shots
   with the patch that shot last; the GPU draws them under the live camera. Patches and
   form-factor rows stay in the worker between jobs, so a material or emission edit re-solves
@@ -108,10 +108,7 @@ def radiosity_key(scene: Scene) -> str:
     objects = [(o.shape, o.material, o.path, o.radius, o.minor_radius, o.height, o.extents,
                 o.size, tuple(map(tuple, o.vertices)), o.subdivisions, o.sections, o.segments,
                 o.translate, o.rotate, o.scale) for o in scene.objects]
-    emitters = sorted(name for name, m in scene.materials.items() if max(m.emission) > 0.0)
-    meshing = (s.meshing, emitters) if s.meshing == "discontinuity" else s.meshing
-    return repr((objects, scene.base_dir, s.patches, meshing, ff_method(scene),
-                 s.hemicube_resolution))
+    return repr((objects, scene.base_dir, s.patches, ff_method(scene), s.hemicube_resolution))
 
 
 def ff_method(scene: Scene) -> str:
@@ -148,12 +145,7 @@ def pipeline_radiosity(scene: Scene, size: tuple[int, int] | None = None,
     from shadelab.radiosity import display
     from shadelab.radiosity.formfactors import FormFactors
     from shadelab.radiosity.patches import check_count
-    from shadelab.radiosity.solution import (
-        base_patches,
-        check_scene,
-        resolve_meshing,
-        solver_steps,
-    )
+    from shadelab.radiosity.solution import base_patches, check_scene, solver_steps
 
     settings = scene.radiosity
     check_count(settings.patches, "radiosity.patches")
@@ -164,8 +156,9 @@ def pipeline_radiosity(scene: Scene, size: tuple[int, int] | None = None,
     reused = cached is not None
     if cached is None:
         yield Progress(None, 0.0, "meshing", {"unit": "patches"})
-        meshing = resolve_meshing(scene, settings.meshing, adaptive=False)
-        patches = base_patches(scene, settings.patches, meshing)
+        # uniform, whatever radiosity.meshing says: the Hemicube & F window (ui/) indexes
+        # the same uniform grid by the shooter's number
+        patches = base_patches(scene, settings.patches, "uniform")
         ff = FormFactors(patches, ff_method(scene), settings.hemicube_resolution)
         cached = (patches, ff, f"ff-{time.time_ns()}")
         _RADIOSITY_CACHE.clear()  # one geometry at a time: the rows can be large
