@@ -11,11 +11,18 @@ is ~0.6 %.
 
 from __future__ import annotations
 
+from pathlib import Path
+
+import numpy as np
 import pytest
 
+from shadelab.bench.radiosity import ERROR_SIZE, SUPERSAMPLE, emitter_ring_mask, image_error
 from shadelab.errors import ShadeLabError
 from shadelab.radiosity.solution import resolve_meshing, solve_scene
 from shadelab.scene.preset import load_preset, save_preset
+
+REFERENCE = Path(__file__).parent / "data" / "cornell-32x32-16kspp.npy"
+GOAL = 0.015  # the bench's goal (radiosity_error_in_2s); measured 1.43 % (1029 patches)
 
 
 @pytest.mark.parametrize("meshing", ["uniform", "adaptive", "discontinuity"])
@@ -69,3 +76,15 @@ def test_the_cli_flag_sets_the_meshing(monkeypatch, tmp_path):
     assert seen["meshing"] == "uniform"
     assert main(["radiosity", "cornell", "-o", out]) == 2
     assert seen["meshing"] == "discontinuity"
+
+
+def test_the_default_meshing_on_cornell_is_within_the_goal():
+    """``shadelab radiosity cornell`` at its defaults against the converged reference."""
+    scene = load_preset("cornell")
+    reference = np.load(REFERENCE)
+    assert reference.shape == (ERROR_SIZE[1], ERROR_SIZE[0], 3)
+    solution = solve_scene(scene)  # the preset's patches, solver, form factors and meshing
+    mask = emitter_ring_mask(solve_scene(scene, 100, meshing="uniform", adaptive=False),
+                             ERROR_SIZE)
+    error = image_error(solution.image(ERROR_SIZE, supersample=SUPERSAMPLE), reference, mask)
+    assert error <= GOAL, f"{error:.4f} with {len(solution.patches)} patches"
