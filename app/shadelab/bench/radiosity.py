@@ -175,7 +175,8 @@ def error_in_budget(scene, quick: bool) -> dict:
 
         solve_scene(scene, 20, "raycast", "gauss-seidel", adaptive=False, meshing=meshing)
         if mask is None:
-            mask = emitter_ring_mask(solve_scene(scene, 100, adaptive=False), size)
+            mask = emitter_ring_mask(solve_scene(scene, 100, adaptive=False, meshing="uniform"),
+                                     size)
         series[meshing] = error_vs_time(scene, size, reference, mask, counts, meshing,
                                         budget_s=BUDGET_S)
     info["noise_floor"] = reference_noise(images, mask)
@@ -213,7 +214,7 @@ def first_lit_image(scene, size, patches: int, repeats: int = 3) -> dict:
     samples = []
     for _ in range(repeats):
         start = time.perf_counter()
-        job = iter_radiosity(scene, size, patches, "raycast", "progressive")
+        job = iter_radiosity(scene, size, patches, "raycast", "progressive", meshing="uniform")
         try:
             for step in job:
                 if step.image is not None and float(step.image.max()) > 0.0:

@@ -7,6 +7,7 @@ import argparse
 from shadelab import limits
 from shadelab.imageio import add_scene_arguments, check_outputs, parse_size, save_outputs
 from shadelab.progress import run_to_end
+from shadelab.scene.model import RADIOSITY_MESHINGS as MESHINGS
 from shadelab.scene.model import RADIOSITY_SOLVERS as SOLVERS
 from shadelab.scene.preset import load_preset
 
@@ -21,8 +22,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="GPU hemicube or ray-cast (Wallace 1989) form factors")
     p.add_argument("--solver", choices=SOLVERS, help="direct, Jacobi, Gauss-Seidel or "
                                                      "progressive refinement")
+    p.add_argument("--meshing", choices=MESHINGS,
+                   help="uniform grid, adaptive (solve-and-split rounds) or discontinuity "
+                        "(shadow boundaries split, hidden cells dropped; default: the "
+                        "preset's radiosity.meshing)")
     p.add_argument("--uniform", action="store_true",
-                   help="regular patches only (no adaptive subdivision)")
+                   help="regular patches only (same as --meshing uniform)")
     p.add_argument("--error", type=float, metavar="BUDGET",
                    help="auto quality: the fewest uniform patches (and hemicube pixels) within "
                         "this relative MSE (e.g. 0.01; see shadelab.studies.autoquality)")
@@ -36,6 +41,10 @@ def run_radiosity(args: argparse.Namespace) -> int:
 
         check_count(args.patches)
     scene = load_preset(args.preset, args.set)
+    if getattr(args, "meshing", None):
+        scene.radiosity.meshing = args.meshing
+    if args.uniform:
+        scene.radiosity.meshing = "uniform"
     limits.check_pixels(size, bytes_per_pixel=64)
     limits.check_patches(args.patches or scene.radiosity.patches,
                          "--patches" if args.patches else "radiosity.patches")
@@ -55,6 +64,7 @@ def run_radiosity(args: argparse.Namespace) -> int:
                                                         args.form_factors)
         scene.radiosity.hemicube_resolution = resolution
         args.uniform = True
+        scene.radiosity.meshing = "uniform"
         print(line)
 
     from shadelab import pipelines

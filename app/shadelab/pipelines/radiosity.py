@@ -3,10 +3,12 @@
 One driver, two ways to watch it:
 
 * :meth:`RadiosityPipeline.run` (``shadelab.render``, ``shadelab radiosity``, the Offline
-  panel): :func:`shadelab.radiosity.solution.iter_radiosity`, adaptive meshing by default; the
+  panel): :func:`shadelab.radiosity.solution.iter_radiosity`, the scene's
+  ``radiosity.meshing`` (discontinuity meshing by default); the
   last step's ``stats["solution"]`` is the :class:`RadiositySolution`, drawn by
   :meth:`RadiosityPipeline.image` (the GL program, or CPU rays with ``display="cpu"``).
-* :meth:`RadiosityPipeline.viewport_job` (the viewer): uniform patches shot by shot
+* :meth:`RadiosityPipeline.viewport_job` (the viewer): uniform patches (whatever
+  ``radiosity.meshing`` says: the Hemicube & F window numbers the same grid) shot by shot
   (progressive refinement), the display triangles (``stats["soup"]``) after each chunk of shots
   with the patch that shot last; the GPU draws them under the live camera. Patches and
   form-factor rows stay in the worker between jobs, so a material or emission edit re-solves
@@ -53,7 +55,7 @@ class RadiosityPipeline(BasePipeline):
 
     def run(self, scene: Scene, size: tuple[int, int] | None = None,
             patches: int | None = None, form_factors: str | None = None,
-            solver: str | None = None, adaptive: bool = True, meshing: str = "uniform",
+            solver: str | None = None, adaptive: bool = True, meshing: str | None = None,
             gpu: bool = False, display: str = "gl") -> Iterator[Progress]:
         """``gpu``: hemicube form factors on the GL hemicube; ``size``: CPU images on the way
         (None: none, as the CLI and shadelab.render do; they draw the result with GL)."""
@@ -154,6 +156,8 @@ def pipeline_radiosity(scene: Scene, size: tuple[int, int] | None = None,
     reused = cached is not None
     if cached is None:
         yield Progress(None, 0.0, "meshing", {"unit": "patches"})
+        # uniform, whatever radiosity.meshing says: the Hemicube & F window (ui/) indexes
+        # the same uniform grid by the shooter's number
         patches = base_patches(scene, settings.patches, "uniform")
         ff = FormFactors(patches, ff_method(scene), settings.hemicube_resolution)
         cached = (patches, ff, f"ff-{time.time_ns()}")

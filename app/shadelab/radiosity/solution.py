@@ -32,7 +32,7 @@ from shadelab.radiosity.solvers import (
     run_solver,
 )
 from shadelab.scene.camera import primary_rays
-from shadelab.scene.model import Scene
+from shadelab.scene.model import RADIOSITY_MESHINGS, Scene
 from shadelab.shading.packing import reflectance
 
 REFINE_SHARE = 0.85  # adaptive meshing starts from this share of the target count (Cornell,
@@ -144,7 +144,7 @@ def _rho_names(scene: Scene, patches: PatchSet) -> str:
 
 
 # ---------------------------------------------------------------------- meshing
-MESHINGS = ("uniform", "discontinuity")
+MESHINGS = RADIOSITY_MESHINGS  # uniform, adaptive (solve-and-split rounds), discontinuity
 
 
 def check_meshing(meshing: str) -> None:
@@ -152,9 +152,20 @@ def check_meshing(meshing: str) -> None:
         raise ShadeLabError(f"meshing {meshing!r}: expected one of {', '.join(MESHINGS)}")
 
 
+def resolve_meshing(scene: Scene, meshing: str | None, adaptive: bool = True) -> str:
+    """The meshing a job uses: ``meshing``, else the scene's ``radiosity.meshing``.
+    ``adaptive=False`` (``--uniform``, the benches, the studies) means a regular grid: it
+    turns "adaptive" and an unnamed meshing into "uniform"."""
+    if meshing is None:
+        meshing = scene.radiosity.meshing if adaptive else "uniform"
+    check_meshing(meshing)
+    return "uniform" if meshing == "adaptive" and not adaptive else meshing
+
+
 def base_patches(scene: Scene, count: int, meshing: str = "uniform") -> PatchSet:
-    """The first mesh: a regular grid, or one refined along contact lines and shadow
-    boundaries (:func:`shadelab.radiosity.meshing.discontinuity_patches`)."""
+    """The first mesh: a regular grid ("uniform", also the start of "adaptive"), or one
+    refined along contact lines and shadow boundaries
+    (:func:`shadelab.radiosity.meshing.discontinuity_patches`)."""
     check_meshing(meshing)
     if meshing == "discontinuity":
         from shadelab.radiosity.meshing import discontinuity_patches
@@ -247,7 +258,7 @@ def iter_radiosity(scene: Scene, size: tuple[int, int] | None = None, patches: i
                    form_factors: str | None = None, solver: str | None = None,
                    adaptive: bool = True, resolution: int | None = None,
                    image_every: float = 0.25, hemicube=None,
-                   meshing: str = "uniform") -> Iterator[Progress]:
+                   meshing: str | None = None) -> Iterator[Progress]:
     """Radiosity as a progressive job: yields :class:`Progress` after each chunk of work.
 
     With ``adaptive`` the job solves a coarse uniform mesh first (``REFINE_SHARE`` of the
@@ -260,19 +271,24 @@ def iter_radiosity(scene: Scene, size: tuple[int, int] | None = None, patches: i
     ``solution`` (a :class:`RadiositySolution`). Close the generator to cancel.
     ``hemicube``: the GPU backend, required when the method is "hemicube"
     (``shadelab.raster.hemicube.Hemicube``; see :class:`FormFactors`).
-    ``meshing``: the first mesh, "uniform" (a regular grid) or "discontinuity" (refined along
-    contact lines and shadow boundaries, hidden cells dropped: :mod:`.meshing`).
+    ``meshing``: "uniform" (a regular grid), "adaptive" (a grid refined in solve-and-split
+    rounds, as above) or "discontinuity" (refined along shadow boundaries before any solve,
+    hidden cells dropped: :mod:`.meshing`); None: the scene's ``radiosity.meshing``.
+    ``adaptive=False`` turns "adaptive" and None into "uniform" (the refinement rounds run
+    only for "adaptive"; see :func:`resolve_meshing`).
     """
     count, method, solver = _settings(scene, patches, form_factors, solver)
-    check_meshing(meshing)
+    meshing = resolve_meshing(scene, meshing, adaptive)
     check_backend(method, hemicube)
     resolution = resolution or scene.radiosity.hemicube_resolution
     precheck(scene, count, method)
     start = time.perf_counter()
     stats = {"form_factors": method, "solver": solver, "target_patches": count}
     yield Progress(None, 0.0, "meshing", dict(stats))
-    refine = adaptive and count >= 8
-    mesh = base_patches(scene, max(1, int(count * REFINE_SHARE)) if refine else count, meshing)
+    refine = meshing == "adaptive" and count >= 8
+    mesh = base_patches(scene, max(1, int(count * REFINE_SHARE)) if refine else count,
+                        "uniform" if meshing == "adaptive" else meshing)
+    stats["meshing"] = meshing
     stages = REFINE_ROUNDS + 1 if refine else 1
     for stage in range(stages):
         stats.update(stage=f"{stage + 1}/{stages}", patches=len(mesh),
@@ -399,7 +415,7 @@ def _fraction(step: Step, scene: Scene) -> float:
 def solve_scene(scene: Scene, patches: int | None = None, form_factors: str | None = None,
                 solver: str | None = None, adaptive: bool = True,
                 resolution: int | None = None, hemicube=None,
-                meshing: str = "uniform") -> RadiositySolution:
+                meshing: str | None = None) -> RadiositySolution:
     """Mesh, compute form factors and solve; returns the solution (no images).
     ``hemicube``: the GPU backend for hemicube form factors, ``meshing`` the first mesh
     (see :func:`iter_radiosity`)."""

@@ -29,6 +29,7 @@ NORMALS_MODES = ("flat", "average", "area", "angle", "crease")
 SHAPES = ("sphere", "box", "plane", "quad", "cylinder", "cone", "torus", "capsule", "mesh")
 TRANSPARENCY_MODELS = ("interpolated", "filtered")
 RADIOSITY_SOLVERS = ("direct", "jacobi", "gauss-seidel", "progressive")
+RADIOSITY_MESHINGS = ("uniform", "adaptive", "discontinuity")
 
 
 def spec(default: Any, kind: str, *args: Any, doc: str = "") -> Any:
@@ -246,6 +247,10 @@ class RadiositySettings(Checked):
     patches: int = spec(400, "int", 1, 1000000, doc="target patch count")
     form_factors: str = spec("raycast", "str", ("hemicube", "raycast", "analytic"), doc="method")
     solver: str = spec("progressive", "str", RADIOSITY_SOLVERS, doc="solver")
+    meshing: str = spec("discontinuity", "str", RADIOSITY_MESHINGS,
+                        doc="uniform (a regular grid) | adaptive (solve, split where it "
+                            "changes fast, solve again) | discontinuity (hidden cells "
+                            "dropped, cells across the lights' shadow boundaries split)")
     hemicube_resolution: int = spec(128, "int", 4, 4096, doc="hemicube face resolution")
     iterations: int = spec(200, "int", 1, 1000000, doc="maximum solver iterations")
     tolerance: float = spec(1e-4, "float", 0.0, 1.0, doc="relative residual to stop at")

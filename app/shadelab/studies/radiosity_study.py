@@ -34,7 +34,7 @@ def solve_timed(scene: Scene, patches: int, method: str, resolution: int, solver
     for _ in range(repeats):
         start = study_clock()
         solution = solve_scene(scene, patches, method, solver, adaptive=False,
-                               resolution=resolution, hemicube=Hemicube)
+                               resolution=resolution, hemicube=Hemicube, meshing="uniform")
         best = min(best, (study_clock() - start) * 1000.0)
     return solution, best
 
@@ -69,7 +69,8 @@ def meshing_table(scene: Scene, quick: bool = False) -> StudyResult:
     size, spp, counts = ((16, 16), 512, (100, 300)) if quick else \
         (bench.ERROR_SIZE, bench.REFERENCE_SPP, (200, 400, 600, 800, 1000, 1200))
     reference, images, _ = bench.converged_reference(scene, size, spp)
-    mask = bench.emitter_ring_mask(solve_scene(scene, 100, adaptive=False), size)
+    mask = bench.emitter_ring_mask(solve_scene(scene, 100, adaptive=False, meshing="uniform"),
+                                   size)
     rows = []
     for meshing in ("uniform", "discontinuity"):
         solve_scene(scene, 20, adaptive=False, meshing=meshing)  # warm-up
