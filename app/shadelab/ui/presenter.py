@@ -257,26 +257,50 @@ def lesson_running(state: AppState) -> bool:
     return state.walk.lesson is not None and state.walk.lesson.step is not None
 
 
+def lesson_captions(lesson) -> list[str]:
+    """Every step's caption of ``lesson``, as the viewport shows them."""
+    from shadelab.lab.lesson_file import LessonRun
+
+    return [LessonRun(lesson, i).caption() for i in range(len(lesson.steps))]
+
+
+def lesson_band_height(captions, measure) -> float:
+    """The caption band kept for a whole lesson: the tallest of its captions, ``measure(text)``
+    being one caption's band height (0 without captions). Pure: the scene keeps its size and
+    place from step to step, so two steps compare cleanly."""
+    return max((measure(text) for text in captions if text), default=0.0)
+
+
+_lesson_bands: dict[tuple, float] = {}   # (captions, width, font px) -> their band height
+
+
+def _lesson_band(state: AppState, width: float) -> float:
+    captions = tuple(lesson_captions(state.walk.lesson.lesson))
+    scale = caption_scale(state)
+    style = imgui.get_style()
+    key = (captions, round(width), round(style.font_size_base * scale * style.font_scale_main, 2))
+    if key not in _lesson_bands:
+        if len(_lesson_bands) > 64:
+            _lesson_bands.clear()
+        _lesson_bands[key] = lesson_band_height(
+            captions, lambda text: caption_height(text, width, scale))
+    return _lesson_bands[key]
+
+
 def caption_band(state: AppState, width: float) -> float:
     """Height of the caption band the viewport keeps under its image (0: no caption); in a
-    lesson it holds a row for the Prev / Next buttons too."""
-    height = caption_height(caption_text(state), width, caption_scale(state))
-    if height and lesson_running(state):
-        height += imgui.get_frame_height_with_spacing()
-    return height
+    lesson it is measured once for all its steps (the tallest caption at this width and
+    font) and holds a row for the Prev / Next buttons too."""
+    if lesson_running(state):
+        height = _lesson_band(state, width)
+        return height + imgui.get_frame_height_with_spacing() if height else height
+    return caption_height(caption_text(state), width, caption_scale(state))
 
 
 def next_step_band(state: AppState, width: float) -> float:
     """The caption band the lesson's next step will keep (its prefetch renders at the size the
-    viewport will have then); the current band where there is no next step."""
-    run = state.walk.lesson
-    if run is None or run.step is None or run.index + 1 >= len(run.lesson.steps):
-        return caption_band(state, width)
-    from shadelab.lab.lesson_file import LessonRun
-
-    text = LessonRun(run.lesson, run.index + 1).caption()
-    height = caption_height(text, width, caption_scale(state))
-    return height + imgui.get_frame_height_with_spacing() if height else height
+    viewport will have then): the lesson's one band."""
+    return caption_band(state, width)
 
 
 LESSON_BUTTONS = ("< Prev (PgUp)", "Next > (PgDn)")
