@@ -203,17 +203,42 @@ def caption_text(state: AppState) -> str:
     return f"{equation}\n{mode}  -  Tab: panels"
 
 
+def caption_font_px(scale: float) -> float:
+    """The caption's glyph height on screen: the base font size times the caption scale and
+    the global factors (presenter, DPI), computed from the style rather than read from ImGui's
+    current font state (issue 22: captions came out small after some steps)."""
+    style = imgui.get_style()
+    return style.font_size_base * scale * style.font_scale_main * style.font_scale_dpi
+
+
+def _push_caption_font(scale: float) -> float:
+    """Push the caption's size; the pixel size it draws at. ImGui leaves its current size
+    as it was in a frame where the window skips items: then the computed size is used."""
+    expected = caption_font_px(scale)
+    imgui.push_font(None, imgui.get_style().font_size_base * scale)
+    got = imgui.get_font_size()
+    return got if abs(got - expected) <= 1.0 else expected
+
+
 def caption_height(text: str, width: float, scale: float) -> float:
     """Height of the caption band for ``text`` wrapped to ``width`` pixels (0 if no text)."""
     if not text:
         return 0.0
     pad = 10.0 * scale / 1.4
-    imgui.push_font(None, imgui.get_style().font_size_base * scale)
+    font_px = _push_caption_font(scale)
     try:  # measured at the size it is drawn at (glyph advances do not scale exactly)
-        text_size = imgui.calc_text_size(text, False, max(width - 2 * pad, 50.0))
+        got = imgui.get_font_size()
+        wrap = max(width - 2 * pad, 50.0)
+        if abs(got - font_px) > 1e-3:   # a stale current size: measure, then rescale
+            text_size = imgui.calc_text_size(text, False, wrap * got / font_px)
+            return text_size.y * font_px / got + 2.5 * pad
+        text_size = imgui.calc_text_size(text, False, wrap)
     finally:
         imgui.pop_font()
     return text_size.y + 2.5 * pad
+
+
+drawn_caption: dict = {}   # the last caption's font px, line and glyph heights (GUI tests)
 
 
 def draw_caption(draw, text: str, origin, size, scale: float,
@@ -226,14 +251,20 @@ def draw_caption(draw, text: str, origin, size, scale: float,
     wrap = max(size[0] - 2 * pad, 50.0)
     if height is None:
         height = caption_height(text, size[0], scale)
-    imgui.push_font(None, imgui.get_style().font_size_base * scale)
+    font_size = _push_caption_font(scale)
     try:
-        font, font_size = imgui.get_font(), imgui.get_font_size()
+        font = imgui.get_font()
         x, y = origin.x + pad, origin.y + size[1] - height + pad
         draw.add_rect_filled(imgui.ImVec2(origin.x, origin.y + size[1] - height),
                              imgui.ImVec2(origin.x + size[0], origin.y + size[1]), 0xA0000000)
         draw.add_text(font, font_size, imgui.ImVec2(x + 1, y + 1), CAPTION_SHADOW, text, wrap)
         draw.add_text(font, font_size, imgui.ImVec2(x, y), CAPTION_COLOR, text, wrap)
+        glyph = font.get_font_baked(font_size).find_glyph(ord("G"))
+        tex = imgui.get_io().fonts.tex_data
+        drawn_caption.update(px=font_size, line=imgui.calc_text_size("Gouraud").y,
+                             glyph=glyph.y1 - glyph.y0, baked=font.get_font_baked(font_size).size,
+                             uv=(glyph.v1 - glyph.v0) * (tex.height if tex else 0),
+                             atlas=(tex.width, tex.height) if tex else (0, 0))
     finally:
         imgui.pop_font()
 
