@@ -78,6 +78,13 @@ def test_caption_glyphs_keep_their_size_through_a_lesson_walk(bigdisplay, tmp_pa
     assert len(set(r["viewport_heights"])) == 1, r["viewport_heights"]
 
 
+def test_caption_glyphs_keep_their_size_through_a_resized_walk(bigdisplay, tmp_path):
+    r = _run("caption_glyphs_resized", bigdisplay, tmp_path)
+    assert r["sizes"][-1] == [1920, 1080]
+    assert len(set(r["px"])) == 1, f"caption font px changed between steps: {r['px']}"
+    assert r["px"][0] == pytest.approx(r["expected"][0], abs=1.0)
+
+
 def test_lesson_walks_forward_and_back(bigdisplay, tmp_path):
     from shadelab.lab.lesson import load_lesson
 
@@ -540,6 +547,38 @@ def scenario_caption_glyphs_1920(ctx, state, out: dict) -> None:
     lines.append(presenter.drawn_caption["line"])
     out.update(px=px, lines=lines, viewport_heights=bands, glyphs=glyphs,
                font_scale_main=imgui.get_style().font_scale_main)
+
+
+def scenario_caption_glyphs_resized(ctx, state, out: dict) -> None:
+    """The way a lecture goes: a few steps at the desk (1280x720), presenter mode on, a few
+    more, the window to 1920x1080, the rest and back: the caption's font px per step."""
+    import glfw
+    from imgui_bundle import glfw_utils, imgui
+
+    from shadelab.lab.lesson import LessonRun, go_to, load_lesson
+    from shadelab.ui import presenter
+
+    state.walk.lesson = LessonRun(load_lesson("phong-to-radiosity"))
+    go_to(state, 0)
+    ctx.yield_(4)
+    px, expected, sizes = [], [], []
+    steps = len(state.walk.lesson.lesson.steps)
+    for i in range(1, steps):
+        if i == 3:
+            state.view.presenter = True
+        if i == 6:
+            glfw.set_window_size(glfw_utils.glfw_window_hello_imgui(), 1920, 1080)
+        ctx.key_press(imgui.Key.page_down)
+        ctx.yield_(4)
+        if i >= 3:
+            px.append(presenter.drawn_caption["px"])
+            expected.append(presenter.caption_font_px(presenter.caption_scale(state)))
+            sizes.append([int(imgui.get_io().display_size.x), int(imgui.get_io().display_size.y)])
+    for _ in range(steps - 1):
+        ctx.key_press(imgui.Key.page_up)
+        ctx.yield_(3)
+        px.append(presenter.drawn_caption["px"])
+    out.update(px=px, expected=expected, sizes=sizes)
 
 
 def _main(name: str, out_dir: str) -> int:
