@@ -265,8 +265,10 @@ def draw_offline_panel(state: AppState) -> bool:
         job.cancel()
     imgui.end_disabled()
     latest, _ = job.snapshot()
-    if idle_note(job):
+    if idle_note(job):   # wrapped: a projector at 1024x768 leaves the panel narrow
+        imgui.push_text_wrap_pos(0.0)
         imgui.text_colored(panels.DIM_COLOR, idle_note(job))
+        imgui.pop_text_wrap_pos()
     if job.started:
         fraction = latest.fraction if latest else 0.0
         word = "running" if job.running else ("cancelled" if job.cancelled else "done")
