@@ -212,8 +212,9 @@ def caption_font_px(scale: float) -> float:
 
 
 def _push_caption_font(scale: float) -> float:
-    """Push the caption's size; the pixel size it draws at. ImGui leaves its current size
-    as it was in a frame where the window skips items: then the computed size is used."""
+    """Push the caption's size; the pixel size it draws at. Should ImGui's current size not
+    follow the push (it keeps the old one in a frame where the window skips items), the
+    computed size is used. A guard: the small captions of issue 22 did not reproduce here."""
     expected = caption_font_px(scale)
     imgui.push_font(None, imgui.get_style().font_size_base * scale)
     got = imgui.get_font_size()
