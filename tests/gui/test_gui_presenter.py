@@ -23,6 +23,7 @@ from gui_harness import capture, private_xvfb, run_scenario_main  # noqa: E402
 
 pytestmark = pytest.mark.gui
 SIZES = {"layout_1024": (1024, 768), "layout_1920": (1920, 1080)}
+WINDOW_SIZES = SIZES | {"caption_glyphs_1920": (1920, 1080)}
 DOCK_WINDOWS = ("Scene", "Lights", "Materials", "Objects", "Equation & probe", "Offline render")
 # every panel, for the content-width check (text carries no item id: only the window's content
 # size shows a line of text that runs past the right edge)
@@ -60,6 +61,28 @@ def test_presenter_layout_cuts_nothing_off(bigdisplay, tmp_path, name):
     assert "I = " in r["caption"] and "Phong" in r["caption"]
     assert r["shown_again"] == sorted(DOCK_WINDOWS + ("Viewport",)) or \
         set(DOCK_WINDOWS) <= set(r["shown_again"])
+
+
+def test_caption_glyphs_keep_their_size_through_a_lesson_walk(bigdisplay, tmp_path):
+    r = _run("caption_glyphs_1920", bigdisplay, tmp_path)
+    assert r["font_scale_main"] == pytest.approx(1.8)
+    assert len(set(r["px"])) == 1, f"caption font px changed between steps: {r['px']}"
+    assert len(set(r["lines"])) == 1, f"caption line height changed: {r['lines']}"
+    assert r["lines"][0] >= r["px"][0] - 1
+    # the glyph drawn: its quad height and its height in the atlas ("G" at the caption size)
+    glyphs = {(g[0], g[1], g[2]) for g in r["glyphs"]}
+    assert len(glyphs) == 1, f"caption glyph changed size between steps: {r['glyphs']}"
+    quad, baked, in_atlas = glyphs.pop()
+    assert baked == r["px"][0] and quad == in_atlas and quad >= 0.5 * baked
+    # one band for the lesson: the image keeps its height from step to step
+    assert len(set(r["viewport_heights"])) == 1, r["viewport_heights"]
+
+
+def test_caption_glyphs_keep_their_size_through_a_resized_walk(bigdisplay, tmp_path):
+    r = _run("caption_glyphs_resized", bigdisplay, tmp_path)
+    assert r["sizes"][-1] == [1920, 1080]
+    assert len(set(r["px"])) == 1, f"caption font px changed between steps: {r['px']}"
+    assert r["px"][0] == pytest.approx(r["expected"][0], abs=1.0)
 
 
 def test_lesson_walks_forward_and_back(bigdisplay, tmp_path):
@@ -493,11 +516,76 @@ def scenario_dialogs(ctx, state, out: dict) -> None:
     out["frames_after_error"] = state.frame - frame
 
 
+def scenario_caption_glyphs_1920(ctx, state, out: dict) -> None:
+    """Presenter mode at 1920x1080: the whole lesson walked without restart, the caption's
+    font size and line height at every step (issue 22: glyphs came out small after a few
+    steps), then the same step opened fresh."""
+    from imgui_bundle import imgui
+
+    from shadelab.lab.lesson import LessonRun, go_to, load_lesson
+    from shadelab.ui import presenter
+
+    state.view.presenter = True
+    ctx.yield_(5)
+    state.walk.lesson = LessonRun(load_lesson("phong-to-radiosity"))
+    go_to(state, 0)
+    ctx.yield_(4)
+    px, lines, bands, glyphs = [], [], [], []
+    for i in range(len(state.walk.lesson.lesson.steps)):
+        if i:
+            ctx.key_press(imgui.Key.page_down)
+            ctx.yield_(4)
+        px.append(presenter.drawn_caption["px"])
+        lines.append(presenter.drawn_caption["line"])
+        bands.append(state.view.viewport_size[1])
+        glyphs.append([presenter.drawn_caption[k] for k in ("glyph", "baked", "uv", "atlas")])
+        if i in (7, 8):   # "8/14 Multiple", "Gouraud": the captions once drawn small
+            capture(ctx, str(Path(OUT_DIR) / f"caption-step{i + 1}.png"))
+    ctx.key_press(imgui.Key.page_up)
+    ctx.yield_(4)
+    px.append(presenter.drawn_caption["px"])
+    lines.append(presenter.drawn_caption["line"])
+    out.update(px=px, lines=lines, viewport_heights=bands, glyphs=glyphs,
+               font_scale_main=imgui.get_style().font_scale_main)
+
+
+def scenario_caption_glyphs_resized(ctx, state, out: dict) -> None:
+    """The way a lecture goes: a few steps at the desk (1280x720), presenter mode on, a few
+    more, the window to 1920x1080, the rest and back: the caption's font px per step."""
+    import glfw
+    from imgui_bundle import glfw_utils, imgui
+
+    from shadelab.lab.lesson import LessonRun, go_to, load_lesson
+    from shadelab.ui import presenter
+
+    state.walk.lesson = LessonRun(load_lesson("phong-to-radiosity"))
+    go_to(state, 0)
+    ctx.yield_(4)
+    px, expected, sizes = [], [], []
+    steps = len(state.walk.lesson.lesson.steps)
+    for i in range(1, steps):
+        if i == 3:
+            state.view.presenter = True
+        if i == 6:
+            glfw.set_window_size(glfw_utils.glfw_window_hello_imgui(), 1920, 1080)
+        ctx.key_press(imgui.Key.page_down)
+        ctx.yield_(4)
+        if i >= 3:
+            px.append(presenter.drawn_caption["px"])
+            expected.append(presenter.caption_font_px(presenter.caption_scale(state)))
+            sizes.append([int(imgui.get_io().display_size.x), int(imgui.get_io().display_size.y)])
+    for _ in range(steps - 1):
+        ctx.key_press(imgui.Key.page_up)
+        ctx.yield_(3)
+        px.append(presenter.drawn_caption["px"])
+    out.update(px=px, expected=expected, sizes=sizes)
+
+
 def _main(name: str, out_dir: str) -> int:
     global OUT_DIR
     OUT_DIR = out_dir
-    return run_scenario_main(globals(), name, out_dir, "lecture", SIZES.get(name, (1280, 720)),
-                             autosave=False)
+    return run_scenario_main(globals(), name, out_dir, "lecture",
+                             WINDOW_SIZES.get(name, (1280, 720)), autosave=False)
 
 
 if __name__ == "__main__":

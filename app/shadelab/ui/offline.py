@@ -230,6 +230,13 @@ def work_done(latest) -> str:
     return latest.message
 
 
+def idle_note(job) -> str:
+    """What the panel says before its first job ("" once one started): no empty result."""
+    if job.started:
+        return ""
+    return "no offline job yet: pick a renderer and a size, then Start"
+
+
 def draw_offline_panel(state: AppState) -> bool:
     """Pick a renderer, run it off the UI thread, compare its image with the raster view."""
     job, options = state.offline.runner, kinds_when_found(state)
@@ -258,6 +265,10 @@ def draw_offline_panel(state: AppState) -> bool:
         job.cancel()
     imgui.end_disabled()
     latest, _ = job.snapshot()
+    if idle_note(job):   # wrapped: a projector at 1024x768 leaves the panel narrow
+        imgui.push_text_wrap_pos(0.0)
+        imgui.text_colored(panels.DIM_COLOR, idle_note(job))
+        imgui.pop_text_wrap_pos()
     if job.started:
         fraction = latest.fraction if latest else 0.0
         word = "running" if job.running else ("cancelled" if job.cancelled else "done")

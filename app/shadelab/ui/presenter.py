@@ -203,17 +203,43 @@ def caption_text(state: AppState) -> str:
     return f"{equation}\n{mode}  -  Tab: panels"
 
 
+def caption_font_px(scale: float) -> float:
+    """The caption's glyph height on screen: the base font size times the caption scale and
+    the global factors (presenter, DPI), computed from the style rather than read from ImGui's
+    current font state (issue 22: captions came out small after some steps)."""
+    style = imgui.get_style()
+    return style.font_size_base * scale * style.font_scale_main * style.font_scale_dpi
+
+
+def _push_caption_font(scale: float) -> float:
+    """Push the caption's size; the pixel size it draws at. Should ImGui's current size not
+    follow the push (it keeps the old one in a frame where the window skips items), the
+    computed size is used. A guard: the small captions of issue 22 did not reproduce here."""
+    expected = caption_font_px(scale)
+    imgui.push_font(None, imgui.get_style().font_size_base * scale)
+    got = imgui.get_font_size()
+    return got if abs(got - expected) <= 1.0 else expected
+
+
 def caption_height(text: str, width: float, scale: float) -> float:
     """Height of the caption band for ``text`` wrapped to ``width`` pixels (0 if no text)."""
     if not text:
         return 0.0
     pad = 10.0 * scale / 1.4
-    imgui.push_font(None, imgui.get_style().font_size_base * scale)
+    font_px = _push_caption_font(scale)
     try:  # measured at the size it is drawn at (glyph advances do not scale exactly)
-        text_size = imgui.calc_text_size(text, False, max(width - 2 * pad, 50.0))
+        got = imgui.get_font_size()
+        wrap = max(width - 2 * pad, 50.0)
+        if abs(got - font_px) > 1e-3:   # a stale current size: measure, then rescale
+            text_size = imgui.calc_text_size(text, False, wrap * got / font_px)
+            return text_size.y * font_px / got + 2.5 * pad
+        text_size = imgui.calc_text_size(text, False, wrap)
     finally:
         imgui.pop_font()
     return text_size.y + 2.5 * pad
+
+
+drawn_caption: dict = {}   # the last caption's font px, line and glyph heights (GUI tests)
 
 
 def draw_caption(draw, text: str, origin, size, scale: float,
@@ -226,14 +252,20 @@ def draw_caption(draw, text: str, origin, size, scale: float,
     wrap = max(size[0] - 2 * pad, 50.0)
     if height is None:
         height = caption_height(text, size[0], scale)
-    imgui.push_font(None, imgui.get_style().font_size_base * scale)
+    font_size = _push_caption_font(scale)
     try:
-        font, font_size = imgui.get_font(), imgui.get_font_size()
+        font = imgui.get_font()
         x, y = origin.x + pad, origin.y + size[1] - height + pad
         draw.add_rect_filled(imgui.ImVec2(origin.x, origin.y + size[1] - height),
                              imgui.ImVec2(origin.x + size[0], origin.y + size[1]), 0xA0000000)
         draw.add_text(font, font_size, imgui.ImVec2(x + 1, y + 1), CAPTION_SHADOW, text, wrap)
         draw.add_text(font, font_size, imgui.ImVec2(x, y), CAPTION_COLOR, text, wrap)
+        glyph = font.get_font_baked(font_size).find_glyph(ord("G"))
+        tex = imgui.get_io().fonts.tex_data
+        drawn_caption.update(px=font_size, line=imgui.calc_text_size("Gouraud").y,
+                             glyph=glyph.y1 - glyph.y0, baked=font.get_font_baked(font_size).size,
+                             uv=(glyph.v1 - glyph.v0) * (tex.height if tex else 0),
+                             atlas=(tex.width, tex.height) if tex else (0, 0))
     finally:
         imgui.pop_font()
 
@@ -257,26 +289,50 @@ def lesson_running(state: AppState) -> bool:
     return state.walk.lesson is not None and state.walk.lesson.step is not None
 
 
+def lesson_captions(lesson) -> list[str]:
+    """Every step's caption of ``lesson``, as the viewport shows them."""
+    from shadelab.lab.lesson_file import LessonRun
+
+    return [LessonRun(lesson, i).caption() for i in range(len(lesson.steps))]
+
+
+def lesson_band_height(captions, measure) -> float:
+    """The caption band kept for a whole lesson: the tallest of its captions, ``measure(text)``
+    being one caption's band height (0 without captions). Pure: the scene keeps its size and
+    place from step to step, so two steps compare cleanly."""
+    return max((measure(text) for text in captions if text), default=0.0)
+
+
+_lesson_bands: dict[tuple, float] = {}   # (captions, width, font px) -> their band height
+
+
+def _lesson_band(state: AppState, width: float) -> float:
+    captions = tuple(lesson_captions(state.walk.lesson.lesson))
+    scale = caption_scale(state)
+    style = imgui.get_style()
+    key = (captions, round(width), round(style.font_size_base * scale * style.font_scale_main, 2))
+    if key not in _lesson_bands:
+        if len(_lesson_bands) > 64:
+            _lesson_bands.clear()
+        _lesson_bands[key] = lesson_band_height(
+            captions, lambda text: caption_height(text, width, scale))
+    return _lesson_bands[key]
+
+
 def caption_band(state: AppState, width: float) -> float:
     """Height of the caption band the viewport keeps under its image (0: no caption); in a
-    lesson it holds a row for the Prev / Next buttons too."""
-    height = caption_height(caption_text(state), width, caption_scale(state))
-    if height and lesson_running(state):
-        height += imgui.get_frame_height_with_spacing()
-    return height
+    lesson it is measured once for all its steps (the tallest caption at this width and
+    font) and holds a row for the Prev / Next buttons too."""
+    if lesson_running(state):
+        height = _lesson_band(state, width)
+        return height + imgui.get_frame_height_with_spacing() if height else height
+    return caption_height(caption_text(state), width, caption_scale(state))
 
 
 def next_step_band(state: AppState, width: float) -> float:
     """The caption band the lesson's next step will keep (its prefetch renders at the size the
-    viewport will have then); the current band where there is no next step."""
-    run = state.walk.lesson
-    if run is None or run.step is None or run.index + 1 >= len(run.lesson.steps):
-        return caption_band(state, width)
-    from shadelab.lab.lesson_file import LessonRun
-
-    text = LessonRun(run.lesson, run.index + 1).caption()
-    height = caption_height(text, width, caption_scale(state))
-    return height + imgui.get_frame_height_with_spacing() if height else height
+    viewport will have then): the lesson's one band."""
+    return caption_band(state, width)
 
 
 LESSON_BUTTONS = ("< Prev (PgUp)", "Next > (PgDn)")

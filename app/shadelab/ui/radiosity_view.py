@@ -105,6 +105,18 @@ def block_means(F: np.ndarray, most: int = HEATMAP_MAX) -> tuple[np.ndarray, int
     return np.nanmean(padded.reshape(m, k, m, k), axis=(1, 3)), k
 
 
+def empty_note(F: np.ndarray | None, rows_done: int) -> str:
+    """What the window says instead of an all-zero F ("" when F has something to show): no
+    patches, or every form factor zero (no patch sees another: no closed surfaces facing
+    each other, e.g. a scene made for the raster pipelines, without radiosity settings)."""
+    if F is None or F.size == 0:
+        return "no patches in this scene: nothing to show"
+    if rows_done >= F.shape[0] and not np.any(F):
+        return ("every form factor is 0: no patch sees another in this scene, so F has "
+                "nothing to show (try a radiosity preset, e.g. radiosity-box)")
+    return ""
+
+
 def patch_id_soup(polygons: np.ndarray, exposure: float = 1.0) -> np.ndarray:
     """(6N, 6) float32 triangles, each patch in its item color (linear radiance that the
     viewport's exposure and sRGB encoding turn back into that color)."""
@@ -247,6 +259,9 @@ def draw_panel(state) -> bool:
         imgui.text_colored(imgui.ImVec4(1.0, 0.35, 0.3, 1.0), view.error)
         return False
     n = len(view.patches)
+    if n == 0:
+        imgui.text_wrapped(empty_note(None, 0))
+        return False
     step_rows(state, view)
     pv = state.view.pipeline_view
     shooter = None if pv is None else pv.stats.get("shooter_index")
@@ -298,9 +313,16 @@ def _draw_matrix(view: RadiosityView, i: int, imgui, implot) -> None:
     from shadelab.ui.layout import plot_size
 
     n = len(view.patches)
+    if n == 0:
+        imgui.text_wrapped(empty_note(None, 0))
+        return
     if view.rows_done < n:
         imgui.text(f"form factors: {view.rows_done}/{n} rows")
         imgui.progress_bar(view.rows_done / n, imgui.ImVec2(-1, 0))
+        return
+    note = empty_note(view.F, view.rows_done)
+    if note:
+        imgui.text_wrapped(note)
         return
     data = heatmap_data(view.F)
     shown, k = block_means(data["matrix"])
