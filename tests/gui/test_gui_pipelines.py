@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from test_gui import _probe_at, _wait, run_scenario  # noqa: E402
+from test_gui import _probe_at, _wait, imgui_key, run_scenario  # noqa: E402
 from test_gui import xdisplay as _xdisplay_fixture  # noqa: E402
 
 from gui_harness import run_scenario_main  # noqa: E402
@@ -167,9 +167,9 @@ def scenario_shadows(ctx, state, out: dict) -> None:
     ctx.combo_click("stencil counting/z-pass")
     ctx.yield_(3)
     out["method"] = state.scene.render.shadow_method
-    ctx.key_press(_key("mod_ctrl") | _key("z"))
+    ctx.key_press(imgui_key("mod_ctrl") | imgui_key("z"))
     ctx.yield_(2)
-    ctx.key_press(_key("mod_ctrl") | _key("z"))
+    ctx.key_press(imgui_key("mod_ctrl") | imgui_key("z"))
     ctx.yield_(2)
     out["undo_shadows"] = state.scene.render.shadows
 
@@ -321,12 +321,6 @@ def scenario_raster_pipelines(ctx, state, out: dict) -> None:
 
 
 OUT_DIR = "."
-
-
-def _key(name: str):
-    from imgui_bundle import imgui
-
-    return int(getattr(imgui.Key, name))  # a plain int: chords OR on every Python 3.11
 
 
 def _main(name: str, out_dir: str) -> int:

@@ -525,6 +525,7 @@ def scenario_caption_glyphs_1920(ctx, state, out: dict) -> None:
     from shadelab.lab.lesson import LessonRun, go_to, load_lesson
     from shadelab.ui import presenter
 
+    presenter.RECORD_CAPTION = True   # the caption's sizes, drawn frame by frame
     state.view.presenter = True
     ctx.yield_(5)
     state.walk.lesson = LessonRun(load_lesson("phong-to-radiosity"))
@@ -558,6 +559,7 @@ def scenario_caption_glyphs_resized(ctx, state, out: dict) -> None:
     from shadelab.lab.lesson import LessonRun, go_to, load_lesson
     from shadelab.ui import presenter
 
+    presenter.RECORD_CAPTION = True   # the caption's sizes, drawn frame by frame
     state.walk.lesson = LessonRun(load_lesson("phong-to-radiosity"))
     go_to(state, 0)
     ctx.yield_(4)

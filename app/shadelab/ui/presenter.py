@@ -239,7 +239,10 @@ def caption_height(text: str, width: float, scale: float) -> float:
     return text_size.y + 2.5 * pad
 
 
-drawn_caption: dict = {}   # the last caption's font px, line and glyph heights (GUI tests)
+# The last caption's font px, line and glyph heights, recorded only while a GUI test sets
+# RECORD_CAPTION (measuring the glyph every frame is work the lecture does not need).
+RECORD_CAPTION = False
+drawn_caption: dict = {}
 
 
 def draw_caption(draw, text: str, origin, size, scale: float,
@@ -260,14 +263,20 @@ def draw_caption(draw, text: str, origin, size, scale: float,
                              imgui.ImVec2(origin.x + size[0], origin.y + size[1]), 0xA0000000)
         draw.add_text(font, font_size, imgui.ImVec2(x + 1, y + 1), CAPTION_SHADOW, text, wrap)
         draw.add_text(font, font_size, imgui.ImVec2(x, y), CAPTION_COLOR, text, wrap)
-        glyph = font.get_font_baked(font_size).find_glyph(ord("G"))
-        tex = imgui.get_io().fonts.tex_data
-        drawn_caption.update(px=font_size, line=imgui.calc_text_size("Gouraud").y,
-                             glyph=glyph.y1 - glyph.y0, baked=font.get_font_baked(font_size).size,
-                             uv=(glyph.v1 - glyph.v0) * (tex.height if tex else 0),
-                             atlas=(tex.width, tex.height) if tex else (0, 0))
+        if RECORD_CAPTION:
+            _record_caption(font, font_size)
     finally:
         imgui.pop_font()
+
+
+def _record_caption(font, font_size: float) -> None:
+    """What a GUI test reads of the caption just drawn (see RECORD_CAPTION)."""
+    glyph = font.get_font_baked(font_size).find_glyph(ord("G"))
+    tex = imgui.get_io().fonts.tex_data
+    drawn_caption.update(px=font_size, line=imgui.calc_text_size("Gouraud").y,
+                         glyph=glyph.y1 - glyph.y0, baked=font.get_font_baked(font_size).size,
+                         uv=(glyph.v1 - glyph.v0) * (tex.height if tex else 0),
+                         atlas=(tex.width, tex.height) if tex else (0, 0))
 
 
 def fps_text(redrawn: bool) -> str:
