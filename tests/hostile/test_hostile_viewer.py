@@ -97,3 +97,20 @@ def test_a_job_started_with_its_panel_hidden_ends_and_the_viewer_exits(shadelab,
              "3", "--window", window, "--screenshot", str(shot), *extra, code=0, xvfb=True,
              timeout=400)
     assert shot.is_file()
+
+
+@needs_xvfb
+@pytest.mark.gui
+@pytest.mark.parametrize("flags", [
+    ["--fullscreen"], ["--presenter", "--compare"], ["--pipeline", "gouraud"],
+    ["--lesson", "phong-to-radiosity", "--step", "3"], ["--probe", "100,100"],
+    ["--exercise", "phong-to-radiosity"], ["--focus", "Lights"],
+    ["--lesson", "phong-to-radiosity", "--no-prefetch"],
+])
+def test_every_documented_viewer_flag_starts_draws_and_exits(shadelab, tmp_path, flags):
+    """Each documented flag of `shadelab view` as a real process under Xvfb with a timeout
+    (--fullscreen asked imgui-bundle for a FullScreenMode member it does not have: exit 1)."""
+    shot = tmp_path / "window.png"
+    shadelab("view", "lecture", "--fresh", "--no-autosave", "--frames", "5", "--window",
+             "1024x768", "--screenshot", str(shot), *flags, code=0, xvfb=True, timeout=180)
+    assert shot.is_file()

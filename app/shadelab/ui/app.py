@@ -501,7 +501,7 @@ def runner_params(viewer: Viewer) -> hello_imgui.RunnerParams:
     params.app_window_params.window_geometry.size = viewer.options.window_size
     if viewer.options.fullscreen:
         params.app_window_params.window_geometry.full_screen_mode = \
-            hello_imgui.FullScreenMode.full_monitor_resolution
+            hello_imgui.FullScreenMode.full_screen_desktop_resolution  # borderless
         viewer.state.view.fullscreen = True
         presenter.mark_fullscreen_applied()
     elif viewer.options.maximized:
