@@ -217,11 +217,13 @@ def probe_arrow_specs(result, camera, aspect: float, fraction: float = ARROW_VIE
         d = np.asarray(direction, dtype=np.float64)
         d = d / max(np.linalg.norm(d), 1e-12)
         full = length * scale
-        if _inside(clip, point, limit) and not _inside(clip, point + full * d, limit):
+        # a point in the margin itself: its arrows stay inside the frame's edge
+        here = limit if _inside(clip, point, limit) else 1.0
+        if _inside(clip, point, here) and not _inside(clip, point + full * d, here):
             lo, hi = 0.0, full            # the screen image of a segment leaves a box once
             for _ in range(30):
                 mid = 0.5 * (lo + hi)
-                lo, hi = (mid, hi) if _inside(clip, point + mid * d, limit) else (lo, mid)
+                lo, hi = (mid, hi) if _inside(clip, point + mid * d, here) else (lo, mid)
             full = lo
         specs.append(ArrowSpec(name, point, d, full, ARROW_COLORS[name[0]]))
     return specs

@@ -96,7 +96,9 @@ def _arrow_names(state: AppState, draw_list, origin, size, bounds) -> None:
         if at is None or base is None:
             continue
         dx, dy = at[0] - base[0], at[1] - base[1]
-        norm = max(np.hypot(dx, dy), 1e-6)
+        norm = np.hypot(dx, dy)
+        if norm < 12.0:          # seen end-on (V points at the eye): beside the point
+            dx, dy, norm = 1.0, 1.0, np.sqrt(2.0)
         text_size = imgui.calc_text_size(spec.name)
         # just past the head, along the arrow's screen direction
         x = origin.x + at[0] + dx / norm * (0.6 * text_size.x + PAD + 2)
@@ -104,28 +106,29 @@ def _arrow_names(state: AppState, draw_list, origin, size, bounds) -> None:
         _plate(draw_list, x, y, spec.name, _u32(spec.color), bounds=bounds)
 
 
-def probe_lines(state: AppState) -> list[tuple[str, int]]:
-    """The probe's readout: each term's RGB, their sum (the shading mode's I) and the GPU's."""
+def probe_lines(state: AppState) -> list[tuple[str, str, int]]:
+    """The probe's readout rows (term, its RGB, colour): each term, their sum (the shading
+    mode's I) and what the GPU drew."""
     result = state.probe.result
     terms = result.terms
 
     def rgb(v) -> str:
-        return " ".join(f"{float(c):.3f}" for c in np.asarray(v, dtype=np.float64).reshape(3))
+        return "  ".join(f"{float(c):.3f}" for c in np.asarray(v, dtype=np.float64).reshape(3))
 
     rows = []
     if np.any(terms.emission):
-        rows.append((f"Le        {rgb(terms.emission)}", DIM_COLOR))
-    rows.append((f"Ia ka Od  {rgb(terms.ambient)}", DIM_COLOR))
+        rows.append(("Le", rgb(terms.emission), DIM_COLOR))
+    rows.append(("Ia ka Od", rgb(terms.ambient), DIM_COLOR))
     diffuse = sum((t.diffuse for t in terms.lights), np.zeros(3))
     specular = sum((t.specular for t in terms.lights), np.zeros(3))
-    rows.append((f"+ diffuse {rgb(diffuse)}", DIM_COLOR))
-    rows.append((f"+ specular {rgb(specular)}", DIM_COLOR))
-    rows.append((f"= I ({result.shading}) {rgb(result.reference)}", TEXT_COLOR))
+    rows.append(("+ diffuse", rgb(diffuse), DIM_COLOR))
+    rows.append(("+ specular", rgb(specular), DIM_COLOR))
+    rows.append((f"= I ({result.shading})", rgb(result.reference), TEXT_COLOR))
     if result.gpu is not None:
         err = float(np.max(np.abs(result.gpu - result.reference)))
         agree = err <= 1e-4 * max(1.0, float(np.max(np.abs(result.reference))))
-        rows.append((f"GPU drew  {rgb(result.gpu)}  " + ("agrees" if agree else
-                                                         f"differs {err:.2g}"),
+        rows.append(("GPU drew", rgb(result.gpu) + ("  agrees" if agree else
+                                                    f"  differs by {err:.2g}"),
                      OK_COLOR if agree else BAD_COLOR))
     return rows
 
@@ -134,13 +137,16 @@ def _probe_readout(state: AppState, draw_list, bounds) -> None:
     """Bottom-left corner of the viewport: never below the fold of a panel."""
     rows = probe_lines(state)
     line = imgui.get_text_line_height_with_spacing()
-    width = max(imgui.calc_text_size(text).x for text, _ in rows)
+    gap = imgui.calc_text_size("  ").x
+    first = max(imgui.calc_text_size(term).x for term, _, _ in rows) + gap
+    width = first + max(imgui.calc_text_size(values).x for _, values, _ in rows)
     x, y = bounds[0] + 2 * PAD + 4, bounds[3] - len(rows) * line - 2 * PAD - 4
     draw_list.add_rect_filled(imgui.ImVec2(x - PAD - 2, y - PAD - 2),
                               imgui.ImVec2(x + width + PAD + 2, y + len(rows) * line + PAD),
                               BOX_COLOR, 4.0)
-    for i, (text, color) in enumerate(rows):
-        draw_list.add_text(imgui.ImVec2(x, y + i * line), color, text)
+    for i, (term, values, color) in enumerate(rows):
+        draw_list.add_text(imgui.ImVec2(x, y + i * line), color, term)
+        draw_list.add_text(imgui.ImVec2(x + first, y + i * line), color, values)
 
 
 def heat_scale(state: AppState) -> tuple[list, float]:
