@@ -44,11 +44,13 @@ def test_a_figure_is_labelled_with_the_coefficients_that_vary():
     assert len(values) == len(ks_n.objects) == 12
     for i, obj in enumerate(ks_n.objects):
         m = ks_n.materials[obj.material]
-        assert values[i] == f"ks = {m.ks:.3g}  n = {m.n:.3g}"
+        assert values[i] == f"ks = {m.ks:.3g}\nn = {m.n:.3g}"
     panes = labels.figure_values(load_preset("transparency"))
-    assert panes == {2: "blue pane (interpolated): interpolated, kt = 0.6",
-                     3: "green pane (filtered): filtered, kt = 0.9",
-                     4: "smoke pane (interpolated): interpolated, kt = 0.75"}
+    assert panes == {2: "blue pane (interpolated)\nkt = 0.6",
+                     3: "green pane (filtered)\nkt = 0.9",
+                     4: "smoke pane (interpolated)\nkt = 0.75"}
+    glass = labels.figure_values(load_preset("cornell-spheres"))
+    assert list(glass.values()) == ["glass_sphere\ninterpolated, kt = 1"]
     assert labels.figure_values(load_preset("lecture")) == {}   # its materials differ in Od
     names = labels.object_names(load_preset("kd-grid"))
     assert names[0] == "kd_0.0 (kd0)" and len(names) == 5
@@ -58,7 +60,7 @@ def test_labels_sit_centred_under_their_objects():
     scene = load_preset("kd-grid")
     size = (536, 727)
     meshes = scene_meshes(scene)
-    placed = labels.place_labels(scene, meshes, size, labels.figure_values(scene), 14.0)
+    placed = labels.place_labels(scene, meshes, size, labels.figure_values(scene), _measure)
     assert [p.object_index for p in placed] == [0, 1, 2, 3, 4]
     cam = scene.camera
     aspect = size[0] / size[1]
@@ -72,9 +74,40 @@ def test_labels_sit_centred_under_their_objects():
         assert p.anchor[1] == pytest.approx(box[3] + labels.LABEL_GAP)
         assert 0 <= box[0] and box[2] <= size[0]
     # text near the bottom edge moves up into the viewport
-    low = labels.place_labels(scene, meshes, (536, 40), {2: "kd = 0.5"}, 14.0)
-    assert labels.screen_box(scene, meshes[2], (536, 40))[3] + labels.LABEL_GAP > 40 - 14.0
-    assert low[0].anchor[1] == pytest.approx(40 - 14.0)
+    low = labels.place_labels(scene, meshes, (536, 40), {2: "kd = 0.5"}, _measure)
+    assert labels.screen_box(scene, meshes[2], (536, 40))[3] + labels.LABEL_GAP > 40 - 27.0
+    assert low[0].anchor[1] == pytest.approx(40 - 27.0)
+
+
+def _measure(text: str) -> tuple[float, float]:
+    """The presenter font's plates (1.8 x): about 10 px a character, 27 px a line."""
+    lines = text.split("\n")
+    return 10.0 * max(len(t) for t in lines), 27.0 * len(lines)
+
+
+@pytest.mark.parametrize("name", ["kd-grid", "ka-grid", "ks-n-grid", "transparency"])
+@pytest.mark.parametrize("size", [(536, 727), (1024, 640), (1024, 727)])
+def test_labels_overlap_neither_each_other_nor_a_figure(name, size):
+    scene = load_preset(name)
+    meshes = scene_meshes(scene)
+    names = labels.object_names(scene)
+    with_names = {i: names[i] + ("\n" + v if v else "") for i, v in
+                  (labels.figure_values(scene) | {0: ""}).items()}
+    for texts in (labels.figure_values(scene), with_names):
+        placed = labels.place_labels(scene, meshes, size, texts, _measure)
+        assert len(placed) == len(texts)
+        boxes = [labels.label_box(p, _measure) for p in placed]
+        for k, a in enumerate(boxes):
+            assert 0 <= a[0] and a[2] <= size[0] and 0 <= a[1] and a[3] <= size[1], placed[k]
+            for b in boxes[k + 1:]:
+                assert not labels._overlap(a, b), (placed[k].text, b)
+    placed = labels.place_labels(scene, meshes, size, labels.figure_values(scene), _measure)
+    boxes = [labels.label_box(p, _measure) for p in placed]
+    if name != "transparency":     # (a pane's label may lie over the panes behind it)
+        for mesh in meshes:
+            shape = labels.screen_box(scene, mesh, size)
+            for p, box in zip(placed, boxes, strict=True):
+                assert not labels._overlap(shape, box), (p.text, scene.objects[mesh.index].name)
 
 
 @pytest.mark.parametrize("name", PRESETS)

@@ -44,8 +44,8 @@ def _same_but_coefficients(a: Material, b: Material) -> bool:
 
 def figure_values(scene: Scene) -> dict[int, str]:
     """Object index -> the text written under it: the coefficients that vary across its
-    figure ("kd = 0.25"; "ks = 0.4  n = 30"), and for a transparent object its name, model
-    and kt. Objects that are part of no figure and not transparent get none."""
+    figure, one a line ("kd = 0.25"; "ks = 0.4" over "n = 30"), and for a transparent object
+    its name, model and kt. Objects in no figure and not transparent get none."""
     out: dict[int, str] = {}
     groups: dict[str, list[int]] = {}
     for i, obj in enumerate(scene.objects):
@@ -62,11 +62,13 @@ def figure_values(scene: Scene) -> dict[int, str]:
         if not varying:
             continue
         for i, m in zip(members, materials, strict=True):
-            out[i] = "  ".join(f"{c} = {_fmt(getattr(m, c))}" for c in varying)
+            out[i] = "\n".join(f"{c} = {_fmt(getattr(m, c))}" for c in varying)
     for i, obj in enumerate(scene.objects):
         m = scene.materials.get(obj.material)
         if m is not None and m.kt > 0.0 and i not in out:
-            out[i] = f"{obj.name or f'object {i}'}: {m.transparency}, kt = {_fmt(m.kt)}"
+            name = obj.name or f"object {i}"
+            model = "" if m.transparency in name else f"{m.transparency}, "
+            out[i] = f"{name}\n{model}kt = {_fmt(m.kt)}"
     return out
 
 
@@ -110,21 +112,52 @@ def screen_box(scene: Scene, mesh: MeshData, size: tuple[int, int]) -> tuple | N
     return float(x.min()), float(y.min()), float(x.max()), float(y.max())
 
 
+def inside_top(scene: Scene) -> set[int]:
+    """Objects whose label goes inside the top of their screen box, not under it: flat
+    transparent panes (a label under a pane would cover what is seen through it)."""
+    return {i for i, obj in enumerate(scene.objects) if obj.shape in ("quad", "plane")
+            and obj.material in scene.materials and scene.materials[obj.material].kt > 0.0}
+
+
 def place_labels(scene: Scene, meshes: list[MeshData], size: tuple[int, int],
-                 texts: dict[int, str], line_height: float) -> list[Label]:
-    """A :class:`Label` under each object ``texts`` names (centred below its screen box),
-    kept inside the viewport; objects off screen or behind the eye get none."""
+                 texts: dict[int, str], measure) -> list[Label]:
+    """A :class:`Label` under each object ``texts`` names (centred below its screen box; a
+    pane's inside its top edge, :func:`inside_top`), kept inside the viewport; objects off
+    screen or behind the eye get none. ``measure(text) -> (width, height)`` in pixels: a
+    label that would cover one placed before it moves to the nearest free place above or
+    below."""
+    inside = inside_top(scene)
     by_index = {m.index: m for m in meshes}
-    out = []
+    out, boxes = [], []
     for i, text in texts.items():
         mesh = by_index.get(i)
         box = None if mesh is None else screen_box(scene, mesh, size)
         if box is None or box[2] < 0 or box[0] > size[0] or box[3] < 0 or box[1] > size[1]:
             continue
-        x = 0.5 * (box[0] + box[2])
-        y = min(box[3] + LABEL_GAP, size[1] - line_height * text.count("\n") - line_height)
-        out.append(Label(text, (x, max(y, 0.0)), i))
+        w, h = measure(text)
+        x = min(max(0.5 * (box[0] + box[2]), 0.5 * w), size[0] - 0.5 * w)
+        want = box[1] + LABEL_GAP if i in inside else box[3] + LABEL_GAP
+        want = max(min(want, size[1] - h), 0.0)
+        # the free place nearest the wanted one: there, or just below or above a label
+        candidates = [want] + [b[3] + 1.0 for b in boxes] + [b[1] - 1.0 - h for b in boxes]
+        free = [c for c in sorted(candidates, key=lambda c: (abs(c - want), c))
+                if 0.0 <= c <= size[1] - h
+                and not any(_overlap(b, (x - 0.5 * w, c, x + 0.5 * w, c + h)) for b in boxes)]
+        y = free[0] if free else want
+        boxes.append((x - 0.5 * w, y, x + 0.5 * w, y + h))
+        out.append(Label(text, (x, y), i))
     return out
+
+
+def label_box(label: Label, measure) -> tuple[float, float, float, float]:
+    """(x0, y0, x1, y1) of a placed label's text."""
+    w, h = measure(label.text)
+    return label.anchor[0] - 0.5 * w, label.anchor[1], label.anchor[0] + 0.5 * w, \
+        label.anchor[1] + h
+
+
+def _overlap(a, b) -> bool:
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
 
 
 def frame_overflow(scene: Scene, meshes: list[MeshData], aspect: float) -> dict[int, float]:

@@ -15,7 +15,7 @@ from shadelab.geometry.normals import normal_mode_difference
 
 WIRE_COLOR = (0.05, 0.05, 0.05)
 NORMAL_COLOR = (0.2, 0.6, 1.0)      # vertex normals
-FACE_NORMAL_COLOR = (1.0, 0.55, 0.1)  # face normals
+FACE_NORMAL_COLOR = (0.3, 1.0, 0.35)  # face normals (no heat-map colour is green)
 ARROW_COLORS = {"N": (1.0, 1.0, 1.0), "V": (0.2, 0.9, 1.0), "L": (1.0, 0.85, 0.1),
                 "R": (1.0, 0.3, 0.9), "H": (1.0, 0.3, 0.9)}
 

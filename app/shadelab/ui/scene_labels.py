@@ -40,7 +40,10 @@ def _plate(draw_list, x: float, y: float, text: str, color: int = TEXT_COLOR,
         y = min(max(y, bounds[1] + PAD), bounds[3] - size.y - PAD)
     draw_list.add_rect_filled(imgui.ImVec2(x0 - PAD, y - PAD),
                               imgui.ImVec2(x0 + size.x + PAD, y + size.y + PAD), BOX_COLOR, 3.0)
-    draw_list.add_text(imgui.ImVec2(x0, y), color, text)
+    line = imgui.get_text_line_height()
+    for k, part in enumerate(text.split("\n")):   # each line centred in the plate
+        dx = 0.5 * (size.x - imgui.calc_text_size(part).x) if centred else 0.0
+        draw_list.add_text(imgui.ImVec2(x0 + dx, y + k * line), color, part)
 
 
 def object_texts(state: AppState) -> dict[int, str]:
@@ -52,6 +55,12 @@ def object_texts(state: AppState) -> dict[int, str]:
             for i in sorted(set(values) | set(names))}
 
 
+def _measure(text: str) -> tuple[float, float]:
+    """A label's plate in pixels (its text and the padding around it)."""
+    size = imgui.calc_text_size(text)
+    return size.x + 2 * PAD + 2, size.y + 2 * PAD + 2
+
+
 def _object_labels(state: AppState, size: tuple[int, int]) -> list[labels.Label]:
     from shadelab.geometry.mesh import scene_meshes
 
@@ -61,7 +70,7 @@ def _object_labels(state: AppState, size: tuple[int, int]) -> list[labels.Label]
            view.show_names, line)
     if _cache.get("key") != key:
         texts = object_texts(state)
-        placed = labels.place_labels(scene, scene_meshes(scene), size, texts, line) \
+        placed = labels.place_labels(scene, scene_meshes(scene), size, texts, _measure) \
             if texts else []
         _cache.update(key=key, labels=placed)
     return _cache["labels"]
@@ -75,7 +84,7 @@ def draw(state: AppState, origin, size: tuple[int, int]) -> None:
                              imgui.ImVec2(bounds[2], bounds[3]), True)
     try:
         for label in _object_labels(state, size):
-            _plate(draw_list, origin.x + label.anchor[0], origin.y + label.anchor[1],
+            _plate(draw_list, origin.x + label.anchor[0], origin.y + label.anchor[1] + PAD + 1,
                    label.text, bounds=bounds)
         result = state.probe.result
         if result is not None:
@@ -165,13 +174,15 @@ def heat_scale(state: AppState) -> tuple[list, float]:
 
 
 def _legend(state: AppState, draw_list, bounds) -> None:
-    """A colour bar, 0 to full scale in degrees, in the viewport's top-left corner."""
+    """A colour bar, 0 to full scale in degrees, in the viewport's bottom-right corner (the
+    probe's readout has the bottom-left one)."""
     _, full = heat_scale(state)
     a, b = state.view.normal_diff_modes
-    title = f"angle between {a} and {b} normals"
+    title = f"angle {a} vs {b}"
     line = imgui.get_text_line_height()
-    width = max(imgui.calc_text_size(title).x, 10 * line)
-    x, y = bounds[0] + 2 * PAD + 4, bounds[1] + 2 * PAD + 4
+    width = max(imgui.calc_text_size(title).x, 9 * line)
+    x = bounds[2] - width - 2 * PAD - 4
+    y = bounds[3] - 3.4 * line - 2 * PAD - 4
     draw_list.add_rect_filled(imgui.ImVec2(x - PAD - 2, y - PAD - 2),
                               imgui.ImVec2(x + width + PAD + 2, y + 3.4 * line + PAD),
                               BOX_COLOR, 4.0)
@@ -185,9 +196,7 @@ def _legend(state: AppState, draw_list, bounds) -> None:
         draw_list.add_rect_filled_multi_color(
             imgui.ImVec2(x0, top), imgui.ImVec2(x1 + 0.5, top + bar),
             _u32(c0), _u32(c1), _u32(c1), _u32(c0))
-    for k in range(5):
-        value = full * k / 4
-        text = f"{value:.0f}\u00b0" if k else "0\u00b0"
-        tx = x + width * k / 4 - (imgui.calc_text_size(text).x if k == 4 else
-                                  0.0 if k == 0 else 0.5 * imgui.calc_text_size(text).x)
+    for k in range(3):   # 0, half and full scale
+        text = f"{full * k / 2:.3g}\u00b0"
+        tx = x + width * k / 2 - imgui.calc_text_size(text).x * k / 2
         draw_list.add_text(imgui.ImVec2(tx, top + bar + 2), TEXT_COLOR, text)
