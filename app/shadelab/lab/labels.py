@@ -157,6 +157,7 @@ def label_box(label: Label, measure) -> tuple[float, float, float, float]:
 
 
 def _overlap(a, b) -> bool:
+    """Two (x0, y0, x1, y1) rectangles share some area."""
     return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
 
 

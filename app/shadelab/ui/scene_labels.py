@@ -15,13 +15,16 @@ from shadelab.lab import labels, overlays
 from shadelab.lab.state import AppState
 
 TEXT_COLOR = 0xFFFFFFFF
-BOX_COLOR = 0xC0101010        # ImGui ABGR: a dark, mostly opaque plate behind the words
+BOX_COLOR = 0xE0101010        # ImGui ABGR: a dark, nearly opaque plate behind the words
 DIM_COLOR = 0xFFB0B0B0
 OK_COLOR = 0xFF70E070
 BAD_COLOR = 0xFF6060FF
 PAD = 3.0
 
 _cache: dict = {}
+#: What the last frame drew, in screen pixels (GUI tests read it): the viewport's origin and
+#: size, each plate's (text, x0, y0, x1, y1), the readout's and the legend's rectangles.
+drawn: dict = {}
 
 
 def _u32(rgb) -> int:
@@ -40,6 +43,8 @@ def _plate(draw_list, x: float, y: float, text: str, color: int = TEXT_COLOR,
         y = min(max(y, bounds[1] + PAD), bounds[3] - size.y - PAD)
     draw_list.add_rect_filled(imgui.ImVec2(x0 - PAD, y - PAD),
                               imgui.ImVec2(x0 + size.x + PAD, y + size.y + PAD), BOX_COLOR, 3.0)
+    drawn.setdefault("plates", []).append((text, x0 - PAD, y - PAD, x0 + size.x + PAD,
+                                           y + size.y + PAD))
     line = imgui.get_text_line_height()
     for k, part in enumerate(text.split("\n")):   # each line centred in the plate
         dx = 0.5 * (size.x - imgui.calc_text_size(part).x) if centred else 0.0
@@ -80,6 +85,8 @@ def draw(state: AppState, origin, size: tuple[int, int]) -> None:
     """Every label over the viewport image at ``origin`` (screen pixels), ``size`` large."""
     draw_list = imgui.get_window_draw_list()
     bounds = (origin.x, origin.y, origin.x + size[0], origin.y + size[1])
+    drawn.clear()
+    drawn.update(origin=(origin.x, origin.y), size=tuple(size))
     draw_list.push_clip_rect(imgui.ImVec2(bounds[0], bounds[1]),
                              imgui.ImVec2(bounds[2], bounds[3]), True)
     try:
@@ -99,6 +106,7 @@ def draw(state: AppState, origin, size: tuple[int, int]) -> None:
 def _arrow_names(state: AppState, draw_list, origin, size, bounds) -> None:
     specs = overlays.probe_arrow_specs(state.probe.result, state.scene.camera,
                                        size[0] / max(size[1], 1))
+    placed: list[tuple] = []
     for spec in specs:
         at = labels.to_pixels(state.scene, size, spec.tip)
         base = labels.to_pixels(state.scene, size, spec.start)
@@ -109,9 +117,18 @@ def _arrow_names(state: AppState, draw_list, origin, size, bounds) -> None:
         if norm < 12.0:          # seen end-on (V points at the eye): beside the point
             dx, dy, norm = 1.0, 1.0, np.sqrt(2.0)
         text_size = imgui.calc_text_size(spec.name)
-        # just past the head, along the arrow's screen direction
-        x = origin.x + at[0] + dx / norm * (0.6 * text_size.x + PAD + 2)
-        y = origin.y + at[1] + dy / norm * (0.6 * text_size.y + PAD + 2) - 0.5 * text_size.y
+        # just past the head, along the arrow's screen direction; further along it while
+        # the plate would cover a name placed before it
+        for step in range(8):
+            reach = 1.0 + 0.8 * step
+            x = origin.x + at[0] + dx / norm * reach * (0.6 * text_size.x + PAD + 2)
+            y = origin.y + at[1] + dy / norm * reach * (0.6 * text_size.y + PAD + 2) \
+                - 0.5 * text_size.y
+            rect = (x - 0.5 * text_size.x - PAD, y - PAD, x + 0.5 * text_size.x + PAD,
+                    y + text_size.y + PAD)
+            if not any(labels._overlap(rect, other) for other in placed):
+                break
+        placed.append(rect)
         _plate(draw_list, x, y, spec.name, _u32(spec.color), bounds=bounds)
 
 
@@ -153,6 +170,8 @@ def _probe_readout(state: AppState, draw_list, bounds) -> None:
     draw_list.add_rect_filled(imgui.ImVec2(x - PAD - 2, y - PAD - 2),
                               imgui.ImVec2(x + width + PAD + 2, y + len(rows) * line + PAD),
                               BOX_COLOR, 4.0)
+    drawn["readout"] = ([term for term, _, _ in rows],
+                        (x - PAD - 2, y - PAD - 2, x + width + PAD + 2, y + len(rows) * line + PAD))
     for i, (term, values, color) in enumerate(rows):
         draw_list.add_text(imgui.ImVec2(x, y + i * line), color, term)
         draw_list.add_text(imgui.ImVec2(x + first, y + i * line), color, values)
@@ -188,6 +207,7 @@ def _legend(state: AppState, draw_list, bounds) -> None:
                               BOX_COLOR, 4.0)
     draw_list.add_text(imgui.ImVec2(x, y), TEXT_COLOR, title)
     top, bar = y + 1.2 * line, 0.9 * line
+    drawn["legend"] = (title, full, (x, top, x + width, top + bar))
     steps = 32
     for k in range(steps):
         c0 = overlays.heat_color_srgb(k / steps)
