@@ -122,10 +122,10 @@ def test_gizmo_drag_moves_the_light_by_the_dragged_distance(bigdisplay, tmp_path
 
 def test_a_lesson_is_picked_and_stepped_from_the_scene_panel(bigdisplay, tmp_path):
     r = _run("lesson_panel", bigdisplay, tmp_path)
-    assert r["picked"] == ["phong-to-radiosity", 0, "sphere-shading"]   # step 1 shown
+    assert r["picked"] == ["phong-to-radiosity", 0, "normals"]   # step 1 shown
     assert r["after_next"] == 1 and r["scene_after_next"] == "lecture"
     assert r["after_prev"] == 0
-    assert r["after_none"] is None and r["scene_after_none"] == "sphere-shading"
+    assert r["after_none"] is None and r["scene_after_none"] == "normals"
 
 
 def test_the_cameras_framing_is_edited_live_from_the_display_section(bigdisplay, tmp_path):

@@ -201,3 +201,25 @@ def terminator_threshold(fn: np.ndarray, cn: np.ndarray) -> float:
         return 0.0
     sine = float(corner_sines(fn, cn).max())
     return sine if sine > 1e-6 else 0.0   # flat faces up to rounding (a rotated box: 1e-8)
+
+
+VERTEX_MODES = ("average", "area", "angle")   # the vertex-normal rules a heat map compares
+
+
+def angle_between_degrees(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(...) the angle between unit vectors ``a`` and ``b`` (..., 3), degrees (atan2 of the
+    cross and dot products: accurate near 0 and 180 degrees, where arccos is not)."""
+    cross = np.linalg.norm(np.cross(a, b), axis=-1)
+    return np.degrees(np.arctan2(cross, np.sum(a * b, axis=-1)))
+
+
+def normal_mode_difference(vertices: np.ndarray, faces: np.ndarray, mode_a: str,
+                           mode_b: str) -> np.ndarray:
+    """(V,) the angle in degrees between each vertex's normal by rule ``mode_a`` and by rule
+    ``mode_b`` (two of :data:`VERTEX_MODES`): where plain averaging, area weighting and angle
+    weighting disagree (a vertex whose faces differ much in size or corner angle)."""
+    for mode in (mode_a, mode_b):
+        if mode not in VERTEX_MODES:
+            raise ValueError(f"normal mode {mode!r}: one of {', '.join(VERTEX_MODES)}")
+    return angle_between_degrees(vertex_normals(vertices, faces, mode_a),
+                                 vertex_normals(vertices, faces, mode_b))

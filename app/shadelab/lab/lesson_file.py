@@ -15,7 +15,8 @@ STEP_KEYS = {"title", "caption", "preset", "set", "pipeline", "focus", "show"}
 # View toggles a step may switch on (every other one is off while the step shows):
 # A lesson step's ``show`` names and the ViewState fields they switch on (state.view).
 SHOW_TOGGLES = {"compare": "compare", "diff": "diff_enabled", "normals": "show_normals",
-                "wireframe": "show_wireframe", "patches": "radiosity_patches"}
+                "wireframe": "show_wireframe", "patches": "radiosity_patches",
+                "face_normals": "show_face_normals", "normal_diff": "show_normal_diff"}
 
 
 def lessons_dir() -> Path:

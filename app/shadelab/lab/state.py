@@ -68,6 +68,11 @@ class ViewState:
     show_wireframe: bool = False
     show_normals: bool = False
     normal_length: float = 0.04       # glyph length, share of the scene's diagonal
+    show_face_normals: bool = False   # one glyph per face, from its centroid
+    show_normal_diff: bool = False    # heat map: angle between two vertex-normal rules
+    normal_diff_modes: tuple[str, str] = ("average", "area")
+    show_values: bool = True          # a figure's values (kd, ka, ks n, kt) under its objects
+    show_names: bool = False          # every object's name and material in the viewport
     compare: bool = False
     diff_enabled: bool = False
     diff_pair: tuple[int, int] = (0, 2)   # indices into COMPARE_VIEWS

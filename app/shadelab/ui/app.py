@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Callable
 
+import moderngl
 import numpy as np
 from imgui_bundle import hello_imgui, imgui, immapp
 
@@ -40,6 +41,7 @@ from shadelab.ui import (
     presenter,
     radiosity_view,
     ray_tree_panel,
+    scene_labels,
     scene_panel,
 )
 from shadelab.ui.exercise_panel import draw_exercise_panel
@@ -96,7 +98,8 @@ SHORTCUTS = (
     (K._3, "3", "Phong shading", _set("shading", "phong")),
     (K.b, "B", "Blinn-Phong / Phong specular", _toggle_blinn),
     (K.w, "W", "wireframe", _toggle("show_wireframe")),
-    (K.n, "N", "normal glyphs", _toggle("show_normals")),
+    (K.n, "N", "vertex normal glyphs", _toggle("show_normals")),
+    (K.l, "L", "object and material names", _toggle("show_names")),
     (K.c, "C", "compare 2x2", _toggle("compare")),
     (K.d, "D", "difference heat map (compare)", _toggle("diff_enabled")),
     (K.r, "R", "reset view", AppState.reset_view),
@@ -227,6 +230,7 @@ class Viewer:
             compare_view.draw_compare(self, size)
         else:
             self.draw_main(size)
+            scene_labels.draw(state, origin, size)   # values, names, arrow names, probe sum
         # the caption and fps readout first: nothing the gizmo does to the draw list's clip
         # rect can hide them
         presenter.draw_viewport_extras(state, origin, size, self.recorder.redrawn, band)
@@ -281,7 +285,8 @@ class Viewer:
         return (id(s.scene), s.scene_version, s.scene.version, size, v.compare, v.diff_enabled,
                 v.diff_pair, v.diff_scale, v.show_wireframe, v.show_normals, v.normal_length,
                 s.probe.version, s.offline.overlay_version, s.offline.show_radiosity, v.tonemap,
-                v.show_clipping, presenter.line_px(s), v.antialias, v.msaa)
+                v.show_clipping, presenter.line_px(s), v.antialias, v.msaa,
+                v.show_face_normals, v.show_normal_diff, v.normal_diff_modes)
 
     def unchanged(self, size: tuple[int, int]) -> bool:
         """True when the last image is still right (idle frames only redraw the GUI)."""
@@ -318,14 +323,19 @@ class Viewer:
         exposure = scene.render.exposure
         meshes = scene_meshes(scene)
         vp.line_width = presenter.line_px(state) * size[0] / max(display_size[0], 1)
+        if state.view.show_normal_diff:   # the surfaces painted by the angle between two rules
+            degrees, full = scene_labels.heat_scale(state)
+            vp.draw_lines(pane, overlays.normal_difference_soup(meshes, degrees, full), exposure,
+                          mode=moderngl.TRIANGLES)
         if state.view.show_wireframe:
             vp.draw_lines(pane, self.cached_lines("wire", meshes), exposure)
-        if state.view.show_normals:
-            vp.draw_lines(pane, self.cached_lines("normals", meshes), exposure)
-        if state.probe.result is not None:
-            length = 0.12 * overlays.scene_diagonal(meshes)
-            vp.draw_lines(pane, overlays.probe_arrows(state.probe.result, length), exposure,
-                          depth_test=False)
+        for kind in ("normals", "face_normals"):
+            if getattr(state.view, "show_" + kind):
+                vp.draw_lines(pane, self.cached_lines(kind, meshes), exposure)
+        if state.probe.result is not None:   # a fixed share of the view, heads inside it
+            specs = overlays.probe_arrow_specs(state.probe.result, scene.camera,
+                                               size[0] / max(size[1], 1))
+            vp.draw_lines(pane, overlays.arrow_lines(specs), exposure, depth_test=False)
         if state.offline.ray_tree is not None:
             lines = overlays.ray_tree_lines(state.offline.ray_tree, overlays.scene_diagonal(meshes))
             vp.draw_lines(pane, lines, exposure, depth_test=False)
@@ -369,6 +379,9 @@ class Viewer:
                 self._line_cache.clear()
             if kind == "wire":
                 lines = overlays.wireframe(meshes)
+            elif kind == "face_normals":
+                length = state.view.normal_length * overlays.scene_diagonal(meshes)
+                lines = overlays.face_normal_glyphs(meshes, length)
             else:
                 length = state.view.normal_length * overlays.scene_diagonal(meshes)
                 lines = overlays.normal_glyphs(meshes, length, scene.render.shading)

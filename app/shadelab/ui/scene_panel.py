@@ -142,16 +142,43 @@ def draw_render_panel(state: AppState) -> bool:
     edited |= edit_fields(scene, [("Ia", intensity_color)])
     _, state.view.show_wireframe = imgui.checkbox("Wireframe (W)", state.view.show_wireframe)
     imgui.same_line()
-    _, state.view.show_normals = imgui.checkbox("Normals (N)", state.view.show_normals)
-    if state.view.show_normals:
+    _, state.view.show_normals = imgui.checkbox("Vertex normals (N)", state.view.show_normals)
+    if same_line_if_fits("Face normals", radio=True):
+        imgui.same_line()
+    _, state.view.show_face_normals = imgui.checkbox("Face normals",
+                                                     state.view.show_face_normals)
+    if state.view.show_normals or state.view.show_face_normals:
         _, state.view.normal_length = slider("glyph length", state.view.normal_length,
                                               0.005, 0.3, True)
+    draw_normal_heat_map_options(state)
+    _, state.view.show_values = imgui.checkbox("Values", state.view.show_values)
+    if imgui.is_item_hovered():
+        imgui.set_tooltip("a figure's kd / ka / ks, n (and a pane's kt) under each object")
+    if same_line_if_fits("Names", radio=True):
+        imgui.same_line()
+    _, state.view.show_names = imgui.checkbox("Names", state.view.show_names)
     changed, mode = combo("normals (all)", "", ("",) + NORMALS_MODES)
     if changed and mode:
         for obj in scene.objects:
             obj.normals = mode
         edited = True
     return edited
+
+
+def draw_normal_heat_map_options(state: AppState) -> None:
+    """The angle between two vertex-normal rules, painted on the surfaces in degrees."""
+    from shadelab.geometry.normals import VERTEX_MODES
+
+    view = state.view
+    _, view.show_normal_diff = imgui.checkbox("Normal heat map", view.show_normal_diff)
+    if imgui.is_item_hovered():
+        imgui.set_tooltip("colour = angle in degrees between the vertex normals of two rules")
+    if not view.show_normal_diff:
+        return
+    a, b = view.normal_diff_modes
+    _, ia = imgui.combo("rule A", VERTEX_MODES.index(a), list(VERTEX_MODES))
+    _, ib = imgui.combo("rule B", VERTEX_MODES.index(b), list(VERTEX_MODES))
+    view.normal_diff_modes = (VERTEX_MODES[ia], VERTEX_MODES[ib])
 
 
 # ---------------------------------------------------------------- compare options
