@@ -331,9 +331,11 @@ def _radiosity_progress(patches, rho, step, shooter, history, base, start, plan,
             else f"iteration {step.iteration}, residual {step.residual:.2e}")
     stats = dict(base, soup=soup(meshes), history={k: list(v) for k, v in history.items()},
                  shots=step.iteration, elapsed_s=time.perf_counter() - start,
-                 rows=rows_known, done=final, B=np.asarray(B, np.float64),
-                 ambient=np.asarray(step.ambient, np.float64), ff_rows=ff_rows,
-                 ambient_shown=bool(settings.ambient))
+                 rows=rows_known, done=final, ff_rows=ff_rows,
+                 ambient_shown=bool(settings.ambient),
+                 # copies: the next shot updates the solver's arrays in place, and a job in
+                 # a thread (step mode) hands this very Progress to the UI
+                 B=np.array(B, np.float64), ambient=np.array(step.ambient, np.float64))
     if shooter >= 0:
         stats["shooter"] = np.asarray(patches.polygons[shooter], np.float32)
         stats["shooter_index"] = int(shooter)

@@ -236,7 +236,8 @@ def _start(state: AppState, name: str, scene, size) -> None:
 
 
 class _StepGate:
-    """Runs a radiosity job one shot per :meth:`step` (a thread job; the UI presses Step)."""
+    """Runs a radiosity job one shot per :meth:`step` (a thread job; the UI presses Step): the
+    first shot comes at once, each press lets the next one through."""
 
     def __init__(self, cancelled) -> None:
         import threading
@@ -249,6 +250,9 @@ class _StepGate:
 
     def wrap(self, gen):
         for item in gen:
+            if "shots" not in (item.stats or {}):   # meshing, form factors: no shot to wait for
+                yield item
+                continue
             while not self.allowed.acquire(timeout=0.05):
                 if self.cancelled.is_set():
                     return
@@ -398,7 +402,13 @@ def status_line(state: AppState) -> str:
     if runner is not None and runner.error:
         word = f"failed: {runner.error}"
     elapsed = runner.elapsed if runner is not None else 0.0
-    return f"{LABELS[name]}: {word}  {view.message}  {elapsed:.1f} s"
+    message = view.message
+    if name == "radiosity" and "shots" in view.stats and not (runner and runner.error):
+        # one short line over the room's ceiling, where the light patch shoots first
+        unshot = view.history.get("unshot") or [float("nan")]
+        done = "done: " if view.stats.get("done") else ""
+        message = f"{done}shot {view.stats['shots']}, unshot {100.0 * unshot[-1]:.2f} %"
+    return f"{LABELS[name]}: {word}  {message}  {elapsed:.1f} s"
 
 
 def pick_ray_tree(state: AppState, name: str, pixel, display_size) -> None:
