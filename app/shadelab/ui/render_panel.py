@@ -277,7 +277,7 @@ def draw_radiosity_controls(state: AppState) -> bool:
     edited |= float_slider("tolerance", r, "tolerance", 1e-7, 0.1, log=True, fmt="%.2g")
     _, state.view.radiosity_patches = imgui.checkbox("draw patches (radiosity pipeline)",
                                                      state.view.radiosity_patches)
-    edited |= checkbox("ambient estimate (radiosity pipeline's shots)", r, "ambient")
+    edited |= checkbox("ambient estimate (progressive)", r, "ambient")
     return edited
 
 
