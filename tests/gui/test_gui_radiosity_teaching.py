@@ -229,6 +229,12 @@ def scenario_teaching(ctx, state, out: dict) -> None:
                      "rows_known": len(pv.runner.rows), "patches": pv.stats["patches"],
                      "shots": pv.stats["shots"]}
     capture(ctx, str(Path(OUT_DIR) / "converged.png"))
+    ctx.scroll_to_y(f"//{PANEL}", 330.0)     # the convergence plot and the matrix
+    ctx.yield_(4)
+    capture(ctx, str(Path(OUT_DIR) / "converged_plots.png"))
+    ctx.scroll_to_bottom(f"//{PANEL}")
+    ctx.yield_(4)
+    capture(ctx, str(Path(OUT_DIR) / "converged_matrix.png"))
 
 
 OUT_DIR = "."

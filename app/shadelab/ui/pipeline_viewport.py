@@ -129,6 +129,11 @@ def draw_on_top(state, origin, display_size: tuple[int, int]) -> None:
     points = [imgui.ImVec2(origin.x + x, origin.y + y) for x, y in outline]
     draw_list.add_polyline(points, SHOOTER_HALO, thick + 4.0, imgui.ImDrawFlags_.closed)
     draw_list.add_polyline(points, SHOOTER_ABGR, thick, imgui.ImDrawFlags_.closed)
+    index = view.stats.get("shooter_index")
+    if index is not None:   # named just below its outline
+        low = outline[:, 1].max() + thick + 4.0
+        label(draw_list, imgui.ImVec2(origin.x + float(outline[:, 0].min()), origin.y + low),
+              f"shooting: patch {index}")
 
 
 def _v(name: str, end: int) -> float:

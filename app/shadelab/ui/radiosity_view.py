@@ -501,12 +501,20 @@ def _draw_convergence(state, imgui) -> None:
     x, y, label = convergence_series(history)
     if x is None:
         return
-    if implot.begin_plot("convergence##hemicube", plot_size(9.0), implot.Flags_.no_legend):
-        implot.setup_axes("shots", label, implot.AxisFlags_.auto_fit, implot.AxisFlags_.auto_fit)
+    title = "unshot energy, % of emitted" if "unshot" in label else "residual, % of |E|"
+    if implot.begin_plot(f"{title}##convergence", plot_size(9.0), implot.Flags_.no_legend):
+        implot.setup_axes("shots" if "unshot" in label else "iterations", axis_label(label),
+                          implot.AxisFlags_.auto_fit, implot.AxisFlags_.auto_fit)
         implot.setup_axis_scale(implot.ImAxis_.y1, implot.Scale_.log10)
         if len(x):
             implot.plot_line(label, x, y)
         implot.end_plot()
+
+
+def axis_label(label: str) -> str:
+    """The y axis's short label (the plot's title says the rest): presenter fonts cut a long
+    vertical label off."""
+    return "unshot (%)" if "unshot" in label else "residual (%)"
 
 
 def convergence_series(history: dict):
