@@ -9,8 +9,13 @@ One driver, two ways to watch it:
   :meth:`RadiosityPipeline.image` (the GL program, or CPU rays with ``display="cpu"``).
 * :meth:`RadiosityPipeline.viewport_job` (the viewer): uniform patches (whatever
   ``radiosity.meshing`` says: the Hemicube & F window numbers the same grid) shot by shot
-  (progressive refinement), the display triangles (``stats["soup"]``) after each chunk of shots
-  with the patch that shot last; the GPU draws them under the live camera. Patches and
+  (progressive refinement), the display triangles (``stats["soup"]``, from a cached
+  :class:`shadelab.radiosity.display.DisplayPlan`) after each chunk of shots with the patch
+  that shot last; the GPU draws them under the live camera. The scene's form factors: the
+  hemicube on a GL context of the job's own (several likely shooters per atlas), ray-cast where
+  none can be made (``stats["form_factors_note"]``); every row computed goes out once in
+  ``stats["ff_rows"]`` for the Hemicube & F window. ``radiosity.ambient`` false: the display
+  shows the light shot so far, without the ambient estimate. Patches, display plan and
   form-factor rows stay in the worker between jobs, so a material or emission edit re-solves
   without re-meshing (``stats["form_factors_reused"]``). Both mesh with
   :func:`shadelab.radiosity.solution.base_patches` and start the solver through one function,

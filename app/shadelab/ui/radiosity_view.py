@@ -1,17 +1,26 @@
-"""Radiosity made visible (issue 10.4): the hemicube of a patch and the form-factor matrix.
+"""Radiosity made visible (issues 10.4, 19.1): the hemicube of a patch and the form-factor matrix.
 
 The "Hemicube & F" window shows, for the shooting patch of the viewport's radiosity (or one
 chosen with the slider), its hemicube unfolded as a cross: the top face in the middle, the
-upper halves of the four side faces around it, each patch id in its own item-buffer color, and
-next to it the same faces weighted by their delta form factors. The sums per face add up to
-the patch's row of F. Below, F as an ImPlot heat map (block means when N > ``HEATMAP_MAX``)
-and its row sums (1 in a closed scene).
+upper halves of the four side faces around it (labelled top, left, back, right, front; their
+sums on the weighted cross), each patch id in its own item-buffer color, and next to it the
+same faces weighted by their delta form factors. The sums per face add up to the patch's row of
+F. Below, which form factors F holds, the convergence plot (unshot energy in % of the emitted
+power against shots), F as an ImPlot heat map (block means when N > ``HEATMAP_MAX``) and its
+row sums (1 in a closed scene). At its top: the radiosity pipeline's stepper (play / step mode
+/ shoot next patch) and the ambient-estimate and patch-grid toggles.
 
-The window asks the viewer's GL side for the work (``state.gpu`` requests, served by
-:mod:`shadelab.ui.gpu_side` with :class:`shadelab.raster.hemicube.Hemicube` before the next
-frame's panels): a patch's item images, and F's rows ``Hemicube.batch`` per frame, so the UI
-never waits. Results are cached per geometry (the patches' key: a material or emission edit
-keeps it) and patch. This module holds no GL object and imports no GL module.
+One method: while the viewport's radiosity solves this window's patches, F holds the very rows
+the solver shot with (the job sends them, ``stats["ff_rows"]``; the runner keeps them,
+:attr:`shadelab.lab.jobs.JobRunner.rows`) and the window says which method made them (the
+lesson's step uses the hemicube, so the picture is how each row was made). Otherwise the window
+computes F itself with the GL hemicube, ``Hemicube.batch`` rows per frame. Its GL work goes
+through ``state.gpu`` (:mod:`shadelab.ui.gpu_side`, before the next frame's panels): a patch's
+item images, and those rows, so the UI never waits. Per frame the window does no work
+proportional to the patches: new rows are copied as they arrive, the heat map's data is rebuilt
+at most every ``MATRIX_EVERY_S`` while rows arrive, and a followed shooter's hemicube changes at
+most every ``FOLLOW_S`` while shots stream. This module holds no GL object and imports no GL
+module.
 """
 
 from __future__ import annotations
@@ -164,6 +173,7 @@ class RadiosityView:
     followed_at: float = 0.0             # when the followed shooter last changed the patch
     label_rects: list = field(default_factory=list)   # face labels drawn (text, x0, y0, x1, y1)
     palette: np.ndarray | None = None    # id_colors of the patches (the crosses' lookup)
+    job_key: tuple = (None, None)        # (the viewport job's scene, its geometry_key)
 
 
 _views: dict[int, RadiosityView] = {}
@@ -269,7 +279,9 @@ def solver_rows(state, view: RadiosityView) -> tuple[dict, dict] | None:
     pv = state.view.pipeline_view
     if pv is None or pv.runner is None or pv.name != "radiosity" or pv.job_scene is None:
         return None
-    if geometry_key(pv.job_scene) != view.key:
+    if view.job_key[0] is not pv.job_scene:      # once per job, not in every frame
+        view.job_key = (pv.job_scene, geometry_key(pv.job_scene))
+    if view.job_key[1] != view.key:
         return None
     return pv.runner.rows, pv.stats
 
@@ -279,8 +291,8 @@ def take_solver_rows(view: RadiosityView, rows: dict) -> None:
     n = len(view.patches)
     if view.source != id(rows):
         view.source, view.known = id(rows), np.zeros(n, bool)
-        view.F = np.zeros((n, n))
-    if len(rows) == int(view.known.sum()):
+        view.F, view.rows_done = np.zeros((n, n)), 0
+    if len(rows) == view.rows_done:
         return
     for i, values in list(rows.items()):
         if 0 <= i < n and not view.known[i] and len(values) == n:
