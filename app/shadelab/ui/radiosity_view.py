@@ -607,16 +607,16 @@ MATRIX_EVERY_S = 0.5   # while rows stream in, the heat map's data is rebuilt at
 
 def matrix_data(view: RadiosityView) -> dict:
     """The heat map's block means, its maximum and F's row sums, rebuilt when F changed (at
-    most every ``MATRIX_EVERY_S`` while rows arrive), not in every frame."""
-    from shadelab.radiosity.formfactors import heatmap_data
-
+    most every ``MATRIX_EVERY_S`` while rows arrive), not in every frame. (The numbers of
+    :func:`shadelab.radiosity.formfactors.heatmap_data`, without importing that numba module
+    on the UI thread: its first import stalled a frame for seconds.)"""
     cached = view.matrix
     now = time.perf_counter()
     if cached is not None and cached["key"] == (view.key, view.source):
         if cached["version"] == view.f_version or now - cached["at"] < MATRIX_EVERY_S:
             return cached
-    data = heatmap_data(view.F)
-    shown, k = block_means(data["matrix"])
+    data = {"row_sums": view.F.sum(axis=1), "max": float(view.F.max(initial=0.0))}
+    shown, k = block_means(view.F)
     view.matrix = {"key": (view.key, view.source), "version": view.f_version, "at": now,
                    "shown": shown, "k": k, "max": data["max"], "row_sums": data["row_sums"],
                    "vmax": float(np.nanmax(shown)) if shown.size else 1.0,
