@@ -99,6 +99,14 @@ def test_the_window_shows_the_solvers_rows_and_labels_the_faces(teaching):
         assert x1 - x0 > 4 and y1 - y0 > 4
 
 
+def test_idle_frames_do_no_work_over_the_patches(teaching):
+    """Once converged, 20 frames draw the slide without redrawing the radiosity triangles or
+    rebuilding the heat map; a camera move redraws them."""
+    idle = teaching[0]["idle"]
+    assert idle["frames"] >= 20 and idle["redraws"] == 0 and not idle["matrix_rebuilt"]
+    assert idle["redraws_after_camera_move"] >= 1
+
+
 def test_play_converges_below_one_percent_unshot(teaching):
     r, _ = teaching
     done = r["played"]
@@ -229,6 +237,29 @@ def scenario_teaching(ctx, state, out: dict) -> None:
                      "rows_known": len(pv.runner.rows), "patches": pv.stats["patches"],
                      "shots": pv.stats["shots"]}
     capture(ctx, str(Path(OUT_DIR) / "converged.png"))
+    # idle frames of the slide: no redraw of the patches' triangles, no heat-map rebuild
+    from shadelab.ui.viewport import Viewport
+
+    calls = []
+    original = Viewport.draw_colored_triangles
+
+    def counted(self, *args, **kwargs):
+        calls.append(1)
+        return original(self, *args, **kwargs)
+
+    Viewport.draw_colored_triangles = counted
+    try:
+        built = rv.view_of(state).matrix["at"]
+        frame = state.frame
+        ctx.yield_(20)
+        out["idle"] = {"frames": state.frame - frame, "redraws": len(calls),
+                       "matrix_rebuilt": rv.view_of(state).matrix["at"] != built}
+        state.scene.camera.eye = tuple(np.add(state.scene.camera.eye, (5.0, 0.0, 0.0)))
+        state.mark_edited()
+        ctx.yield_(3)
+        out["idle"]["redraws_after_camera_move"] = len(calls)
+    finally:
+        Viewport.draw_colored_triangles = original
     ctx.scroll_to_y(f"//{PANEL}", 330.0)     # the convergence plot and the matrix
     ctx.yield_(4)
     capture(ctx, str(Path(OUT_DIR) / "converged_plots.png"))
