@@ -187,10 +187,22 @@ def view_of(state) -> RadiosityView:
     return _views.setdefault(id(state), RadiosityView())
 
 
+_KEYS: dict = {}   # (edit key of objects and radiosity settings, base_dir) -> geometry_key
+
+
 def geometry_key(scene) -> tuple:
+    """What the patches depend on. Asked in every frame: the full key (a repr of every
+    object) is built once per edit of the objects or radiosity settings (a copy of a scene
+    shares its original's edit key, so the viewport job's scene finds it too)."""
     from shadelab.lab.pipeline_jobs import radiosity_key
 
-    return (radiosity_key(scene), scene.radiosity.hemicube_resolution)
+    edit = (scene.edit_key("objects", "radiosity"), scene.base_dir)
+    key = _KEYS.get(edit)
+    if key is None:
+        if len(_KEYS) > 8:
+            _KEYS.clear()
+        key = _KEYS[edit] = (radiosity_key(scene), scene.radiosity.hemicube_resolution)
+    return key
 
 
 def ensure(state, view: RadiosityView | None = None) -> RadiosityView:
