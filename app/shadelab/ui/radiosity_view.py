@@ -174,6 +174,8 @@ class RadiosityView:
     label_rects: list = field(default_factory=list)   # face labels drawn (text, x0, y0, x1, y1)
     palette: np.ndarray | None = None    # id_colors of the patches (the crosses' lookup)
     job_key: tuple = (None, None)        # (the viewport job's scene, its geometry_key)
+    building: object = None              # the thread making the patches (ensure)
+    built: dict = field(default_factory=dict)   # its result: "patches" or "error"
 
 
 _views: dict[int, RadiosityView] = {}
@@ -205,32 +207,56 @@ def geometry_key(scene) -> tuple:
     return key
 
 
-def ensure(state, view: RadiosityView | None = None) -> RadiosityView:
-    """Patches for the scene's geometry (rebuilt when it changed; the GL side makes the
-    hemicube of them on the first request)."""
-    from shadelab.errors import ShadeLabError
-    from shadelab.radiosity.patches import check_count, uniform_patches
+def ensure(state, view: RadiosityView | None = None, wait: bool = False) -> RadiosityView:
+    """Patches for the scene's geometry, rebuilt when it changed: in a thread (a 400-patch
+    grid took ~100 ms, a stalled frame of the slide); ``view.patches`` is None until they are
+    there (``wait``: build them now). The GL side makes their hemicube on the first request."""
+    import threading
+
+    from shadelab.scene.preset import clone_scene
 
     view = view or view_of(state)
     scene = state.scene
     key = geometry_key(scene)
-    if key == view.key:
-        return view
-    view.key, view.views, view.shown, view.error = key, {}, None, ""
-    view.res, view.batch = 0, 0
+    if key != view.key:
+        view.key, view.views, view.shown, view.error = key, {}, None, ""
+        view.res, view.batch, view.patches, view.built = 0, 0, None, {}
+        view.id_soup = None
+        copy, result = clone_scene(scene), view.built
+        view.building = threading.Thread(target=_build_patches, args=(copy, result),
+                                         daemon=True, name="shadelab-hemicube-patches")
+        view.building.start()
+    if view.building is not None and (wait or not view.building.is_alive()):
+        view.building.join()
+        view.building = None
+        _take_patches(view, view.built, scene.render.exposure)
+    return view
+
+
+def _build_patches(scene, result: dict) -> None:
+    from shadelab.errors import ShadeLabError
+    from shadelab.radiosity.patches import check_count, uniform_patches
+
     try:
         check_count(scene.radiosity.patches, "radiosity.patches")
-        view.patches = uniform_patches(scene, scene.radiosity.patches)
+        result["patches"] = uniform_patches(scene, scene.radiosity.patches)
     except ShadeLabError as exc:
-        view.patches, view.error = None, str(exc)
-        return view
+        result["error"] = str(exc)
+    except Exception as exc:   # shown in the window; the session goes on
+        result["error"] = f"{type(exc).__name__}: {exc}"
+
+
+def _take_patches(view: RadiosityView, result: dict, exposure: float) -> None:
+    if "error" in result or "patches" not in result:
+        view.patches, view.error = None, result.get("error", "no patches")
+        return
+    view.patches = result["patches"]
     n = len(view.patches)
     view.F, view.rows_done, view.known, view.source = np.zeros((n, n)), 0, np.zeros(n, bool), None
     view.matrix = None
-    view.patch = min(view.patch, n - 1)
-    view.id_soup = patch_id_soup(view.patches.polygons, scene.render.exposure)
+    view.patch = min(view.patch, max(n - 1, 0))
+    view.id_soup = patch_id_soup(view.patches.polygons, exposure)
     view.palette = id_colors(np.arange(n))
-    return view
 
 
 def _ask(state, view: RadiosityView, what: str, **args) -> None:
@@ -334,6 +360,9 @@ def draw_panel(state) -> bool:
     view = ensure(state)
     if view.error:
         imgui.text_colored(imgui.ImVec4(1.0, 0.35, 0.3, 1.0), view.error)
+        return edited
+    if view.patches is None:
+        imgui.text("building the patches ...")
         return edited
     n = len(view.patches)
     if n == 0:
