@@ -122,3 +122,50 @@ def test_patch_id_soup_round_trips_to_the_item_colors():
     srgb = to_srgb8(soup[::6, 3:].reshape(1, 5, 3).astype(np.float32), 2.0)[0]
     np.testing.assert_allclose(srgb.astype(int), rv.id_colors(np.arange(5)).astype(int),
                                atol=1)
+
+
+def test_face_labels_sit_on_their_faces_of_the_unfolded_cross():
+    """Each label's box is centred on its own face of the cross unfold() lays out (top in
+    the middle, left = +t, back = +b, right = -t, front = -b): the face index at the label's
+    centre is that face's."""
+    res, side = 16, 320.0
+    top = np.zeros((res, res), int)
+    sides = [np.full((res // 2, res), k, int) for k in (1, 2, 3, 4)]
+    cross = rv.unfold(top, sides, fill=-1)
+
+    def measure(text):
+        return 9.0 * len(text), 14.0
+
+    labels = rv.face_label_positions(side, rv.FACES, measure)
+    assert [t for *_, t in labels] == ["top", "left", "back", "right", "front"]
+    for face, (x, y, text) in enumerate(labels):
+        w, h = measure(text)
+        cx, cy = x + w / 2, y + h / 2
+        assert cross[int(cy / side * 2 * res), int(cx / side * 2 * res)] == face, text
+
+
+def test_convergence_series_in_percent_with_units():
+    x, y, label = rv.convergence_series({"iteration": [1, 2, 3], "unshot": [0.5, 0.1, 0.0],
+                                         "residual": [float("nan")] * 3})
+    assert list(x) == [1.0, 2.0] and list(y) == [50.0, 10.0]   # 0 cannot go on a log axis
+    assert label == "unshot energy (% of emitted)" and rv.axis_label(label) == "unshot (%)"
+    x, y, label = rv.convergence_series({"iteration": [1], "unshot": [float("nan")],
+                                         "residual": [0.02]})
+    assert list(y) == [2.0] and "residual" in label
+    assert rv.convergence_series({}) == (None, None, "")
+
+
+def test_geometry_key_follows_geometry_edits_only():
+    from shadelab.scene.preset import clone_scene
+
+    scene = load_preset("cornell")
+    key = rv.geometry_key(scene)
+    assert rv.geometry_key(clone_scene(scene)) == key       # the job's copy: the same key
+    scene.materials["white"].kd = 0.5
+    assert rv.geometry_key(scene) == key                    # a material: same patches
+    scene.objects[0].vertices = [[552.8, 7.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 559.2],
+                                 [549.6, 0.0, 559.2]]
+    moved = rv.geometry_key(scene)
+    assert moved != key and "7.0" in moved[0]
+    scene.radiosity.patches = 123
+    assert rv.geometry_key(scene) != moved

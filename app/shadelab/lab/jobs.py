@@ -162,6 +162,8 @@ class JobRunner:
         self.kill_after: float | None = KILL_AFTER   # of that cancel (None: never killed)
         self.version = 0                # bumps on every new Progress (the UI re-uploads then)
         self.trail: list[dict] = []     # every Progress of the job, in brief (the UI may skip some)
+        self.rows: dict = {}            # rows of a matrix the job sends in pieces, every piece
+        #                                 kept (stats["ff_rows"]: radiosity's form factors)
         self._cancel = threading.Event()
         self._thread: threading.Thread | None = None
         self._lock = threading.Lock()
@@ -186,7 +188,7 @@ class JobRunner:
         """
         self.cancel(wait=True)
         self.name, self.latest, self.error, self.cancelled = name, None, "", False
-        self.trail = []
+        self.trail, self.rows = [], {}
         self.started, self.finished = time.perf_counter(), 0.0
         self._cancel.clear()
         self._job_id += 1
@@ -222,6 +224,9 @@ class JobRunner:
         """Make ``step`` the newest Progress (under the lock) and note it in the trail."""
         self.latest = step
         self.version += 1
+        rows = (step.stats or {}).get("ff_rows") if isinstance(step.stats, dict) else None
+        if rows is not None and len(rows) == 2 and len(rows[0]) == len(rows[1]):
+            self.rows.update(zip((int(i) for i in rows[0]), rows[1], strict=True))
         if len(self.trail) < TRAIL_MAX:
             stats = step.stats or {}
             self.trail.append({"fraction": float(step.fraction), "level": stats.get("level"),

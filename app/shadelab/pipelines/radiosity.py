@@ -9,8 +9,13 @@ One driver, two ways to watch it:
   :meth:`RadiosityPipeline.image` (the GL program, or CPU rays with ``display="cpu"``).
 * :meth:`RadiosityPipeline.viewport_job` (the viewer): uniform patches (whatever
   ``radiosity.meshing`` says: the Hemicube & F window numbers the same grid) shot by shot
-  (progressive refinement), the display triangles (``stats["soup"]``) after each chunk of shots
-  with the patch that shot last; the GPU draws them under the live camera. Patches and
+  (progressive refinement), the display triangles (``stats["soup"]``, from a cached
+  :class:`shadelab.radiosity.display.DisplayPlan`) after each chunk of shots with the patch
+  that shot last; the GPU draws them under the live camera. The scene's form factors: the
+  hemicube on a GL context of the job's own (several likely shooters per atlas), ray-cast where
+  none can be made (``stats["form_factors_note"]``); every row computed goes out once in
+  ``stats["ff_rows"]`` for the Hemicube & F window. ``radiosity.ambient`` false: the display
+  shows the light shot so far, without the ambient estimate. Patches, display plan and
   form-factor rows stay in the worker between jobs, so a material or emission edit re-solves
   without re-meshing (``stats["form_factors_reused"]``). Both mesh with
   :func:`shadelab.radiosity.solution.base_patches` and start the solver through one function,
@@ -22,6 +27,7 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import dataclass
 from typing import Iterator
 
 import numpy as np
@@ -112,9 +118,42 @@ def radiosity_key(scene: Scene) -> str:
 
 
 def ff_method(scene: Scene) -> str:
-    """The worker has no GL context: the GPU hemicube becomes ray-cast form factors there."""
-    method = scene.radiosity.form_factors
-    return "raycast" if method == "hemicube" else method
+    """The form-factor method the viewer's job asks for: the scene's. "hemicube" runs on a GL
+    context of the job's own (:func:`_hemicube_backend`), ray-cast only where none can be made
+    (the job's ``stats["form_factors"]`` says which ran)."""
+    return scene.radiosity.form_factors
+
+
+def _hemicube_backend() -> tuple[object, object, str]:
+    """(hemicube factory for :class:`FormFactors`, release callback, "" or why not).
+
+    The worker process's jobs run in its main thread and share its headless context (kept
+    between jobs, as the form factors are); a job in a thread of the viewer (step mode) gets a
+    context of its own, released when the job ends (a GL context is current in one thread)."""
+    import threading
+    from functools import partial
+
+    try:
+        from shadelab.gl.context import create_headless_context, headless_context
+        from shadelab.raster.hemicube import Hemicube  # GL only in the job, only when asked
+
+        if threading.current_thread() is threading.main_thread():
+            return partial(Hemicube, ctx=headless_context()), None, ""
+        ctx = create_headless_context()
+    except Exception as exc:   # no GL for the job: ray-cast rows, said in the stats
+        return None, None, str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+    made = []
+
+    def factory(*args, **kwargs):
+        made.append(Hemicube(*args, ctx=ctx, **kwargs))
+        return made[-1]
+
+    def release():
+        for cube in made:
+            cube.release()
+        ctx.release()
+
+    return factory, release, ""
 
 
 def soup(vertices_faces_colors: list) -> np.ndarray:
@@ -137,11 +176,34 @@ def _reflectance(scene: Scene, patches) -> tuple[np.ndarray, np.ndarray]:
     return rho, emission
 
 
+@dataclass
+class _Cached:
+    """What the worker keeps of one geometry between jobs (``_RADIOSITY_CACHE``)."""
+
+    patches: object
+    rows: dict                 # patch -> its form-factor row, every row computed so far
+    token: str
+    ff: object = None          # the FormFactors engine, when it may outlive the job
+    method: str = ""
+    plan: object = None        # the display's geometry (radiosity.display.DisplayPlan)
+
+
+def hemicube_batch(resolution: int) -> int:
+    """Rows one hemicube atlas renders at once (:class:`shadelab.raster.hemicube.Hemicube`)."""
+    res = max(2, int(resolution) // 2 * 2)
+    return max(1, min(32, 4096 // res))
+
+
 def pipeline_radiosity(scene: Scene, size: tuple[int, int] | None = None,
                        step_shots: int = 0) -> Iterator[Progress]:
-    """Radiosity shot by shot; ``stats``: display ``soup``, ``shooter`` (4, 3) corners,
-    ``history``, ``patches``, ``form_factors_reused`` and the form factors' ``ff_token``.
-    ``step_shots`` > 0 yields after every that many shots (the step button)."""
+    """Radiosity shot by shot; ``stats``: display ``soup``, ``shooter`` (4, 3) corners and
+    ``shooter_index``, the patches' display radiosity ``B`` (N, 3) and the ``ambient``
+    estimate, ``history``, ``patches``, ``form_factors`` (the method that ran),
+    ``form_factors_reused``, the form factors' ``ff_token`` and ``ff_rows`` (indices, rows:
+    the rows of F computed since the last Progress; every known row in the first), so the
+    Hemicube & F window shows the very rows the solver used. ``step_shots`` > 0 yields after
+    every that many shots (the step button). ``radiosity.ambient`` false: the display shows the
+    light shot so far only."""
     from shadelab.radiosity import display
     from shadelab.radiosity.formfactors import FormFactors
     from shadelab.radiosity.patches import check_count
@@ -159,32 +221,96 @@ def pipeline_radiosity(scene: Scene, size: tuple[int, int] | None = None,
         # uniform, whatever radiosity.meshing says: the Hemicube & F window (ui/) indexes
         # the same uniform grid by the shooter's number
         patches = base_patches(scene, settings.patches, "uniform")
-        ff = FormFactors(patches, ff_method(scene), settings.hemicube_resolution)
-        cached = (patches, ff, f"ff-{time.time_ns()}")
+        cached = _Cached(patches, {}, f"ff-{time.time_ns()}")
         _RADIOSITY_CACHE.clear()  # one geometry at a time: the rows can be large
         _RADIOSITY_CACHE[key] = cached
-    patches, ff, token = cached
+    patches, rows = cached.patches, cached.rows
+    release = None
+    if cached.ff is not None:
+        ff, method, note = cached.ff, cached.method, ""
+    else:
+        method, hemicube, note = settings.form_factors, None, ""
+        if method == "hemicube":
+            hemicube, release, note = _hemicube_backend()
+            method = method if hemicube is not None else "raycast"
+        ff = FormFactors(patches, method, settings.hemicube_resolution, hemicube=hemicube)
+        if release is None:
+            cached.ff, cached.method = ff, method
+    if cached.plan is None:
+        cached.plan = display.DisplayPlan(patches)
+    try:
+        yield from _shoot(scene, patches, ff, method, rows, cached.token, reused, note, start,
+                          step_shots, cached.plan, solver_steps)
+    finally:
+        if release is not None:
+            release()
+
+
+def _shoot(scene, patches, ff, method, rows, token, reused, note, start, step_shots, plan,
+           solver_steps) -> Iterator[Progress]:
+    settings = scene.radiosity
     rho, emission = _reflectance(scene, patches)
     n = len(patches)
-    base = {"patches": n, "form_factors": ff.method, "solver": settings.solver,
-            "form_factors_reused": reused, "ff_token": token, "unit": "patches"}
+    label = method + (f" {settings.hemicube_resolution}x{settings.hemicube_resolution}"
+                      if method == "hemicube" else "")
+    base = {"patches": n, "form_factors": method, "form_factors_label": label,
+            "solver": settings.solver, "form_factors_reused": reused, "ff_token": token,
+            "unit": "patches", "meshing_s": time.perf_counter() - start}
+    if note:
+        base["form_factors_note"] = f"hemicube asked, ray-cast used: no GL context ({note})"
     shooter = [-1]
+    fresh = list(rows)                   # the rows the next Progress sends
+    batch = hemicube_batch(settings.hemicube_resolution) if method == "hemicube" else 1
+    areas = patches.areas
+    shot = np.zeros_like(emission)       # what each patch has shot (its B when it shot)
+    latest: list = [None]                # the solver's B (updated in place by each shot)
 
     def row(i: int) -> np.ndarray:
         shooter[0] = i
-        return ff.row(i)
+        if i not in rows:
+            todo = [i]
+            if batch > 1:   # the likeliest next shooters share the atlas (one read-back)
+                B = latest[0] if latest[0] is not None else math.pi * emission
+                energy = ((B - shot) * areas[:, None]).sum(axis=1)
+                known = np.fromiter(rows, np.int64, len(rows))
+                energy[known] = -np.inf
+                energy[i] = -np.inf
+                order = np.argsort(-energy)[:batch - 1]
+                todo += [int(j) for j in order if energy[j] > 0.0]
+            for j, values in zip(todo, ff.compute_rows(np.asarray(todo, np.int64)),
+                                 strict=True):
+                rows[j] = values
+                fresh.append(j)
+        shot[i] = latest[0][i] if latest[0] is not None else math.pi * emission[i]
+        return rows[i]
 
     # the same driver as run(): right-hand side with the lights' first shot, form factors,
     # solver; only the streaming below differs (form factors here may come from the cache)
     steps = yield from solver_steps(scene, patches, ff, settings.solver, base, (0.0, 0.05),
                                     rho=rho, emission=emission, row=row)
+    if settings.solver != "progressive":   # a gathering solver computed all of F
+        for i in range(n):
+            if i not in rows:
+                rows[i] = ff.row(i)
+                fresh.append(i)
     base.pop("form_factors_s", None)
-    history = {"iteration": [], "residual": [], "unshot": []}
+    history = {"iteration": [], "residual": [], "unshot": [], "time_s": []}
     last, last_yield, since = None, 0.0, 0
+
+    def progress(final: bool) -> Progress:
+        sent = sorted(set(fresh))
+        fresh.clear()
+        values = np.stack([rows[i] for i in sent]) if sent else np.zeros((0, n))
+        return _radiosity_progress(patches, rho, last, shooter[0], history, base, start,
+                                   plan, len(rows), final, settings,
+                                   (np.asarray(sent, np.int64), values))
+
     for last in steps:
+        latest[0] = last.B
         history["iteration"].append(last.iteration)
         history["residual"].append(float(last.residual))
         history["unshot"].append(float(last.unshot))
+        history["time_s"].append(time.perf_counter() - start)
         since += 1
         now = time.perf_counter()
         if step_shots > 0 and since < step_shots:
@@ -192,18 +318,16 @@ def pipeline_radiosity(scene: Scene, size: tuple[int, int] | None = None,
         if step_shots <= 0 and now - last_yield < RADIOSITY_CHUNK_S and last.iteration > 1:
             continue
         since, last_yield = 0, now
-        yield _radiosity_progress(patches, rho, last, shooter[0], history, base, start,
-                                  display, ff, final=False, settings=settings)
+        yield progress(final=False)
     if last is None:
         return
-    yield _radiosity_progress(patches, rho, last, shooter[0], history, base, start, display,
-                              ff, final=True, settings=settings)
+    yield progress(final=True)
 
 
-def _radiosity_progress(patches, rho, step, shooter, history, base, start, display, ff,
-                        final: bool, settings) -> Progress:
-    B = step.display_B(rho)
-    meshes = display.display_meshes(patches, B / math.pi, True)
+def _radiosity_progress(patches, rho, step, shooter, history, base, start, plan,
+                        rows_known: int, final: bool, settings, ff_rows) -> Progress:
+    B = step.display_B(rho) if settings.ambient else step.B
+    meshes = plan.meshes(B / math.pi)
     value = step.unshot if np.isnan(step.residual) else step.residual
     tol = max(settings.tolerance, 1e-12)
     fraction = 1.0 if final or not value > tol else \
@@ -212,11 +336,13 @@ def _radiosity_progress(patches, rho, step, shooter, history, base, start, displ
             else f"iteration {step.iteration}, residual {step.residual:.2e}")
     stats = dict(base, soup=soup(meshes), history={k: list(v) for k, v in history.items()},
                  shots=step.iteration, elapsed_s=time.perf_counter() - start,
-                 rows=len(ff._rows), done=final)
+                 rows=rows_known, done=final, ff_rows=ff_rows,
+                 ambient_shown=bool(settings.ambient),
+                 # copies: the next shot updates the solver's arrays in place, and a job in
+                 # a thread (step mode) hands this very Progress to the UI
+                 B=np.array(B, np.float64), ambient=np.array(step.ambient, np.float64))
     if shooter >= 0:
         stats["shooter"] = np.asarray(patches.polygons[shooter], np.float32)
         stats["shooter_index"] = int(shooter)
     return Progress(None, max(fraction, 0.0), ("done: " if final else "") + what
                     + f" ({len(patches)} patches; {base['light']})", stats)
-
-

@@ -236,3 +236,172 @@ def _open_interior_edges(faces: np.ndarray, points: np.ndarray) -> int:
                        for bound in (lo, hi) for k in (0, 1))
         count += 0 if on_outer else 1
     return count
+
+
+# ---------------------------------------------------------------- the viewer's cached plan
+class DisplayPlan:
+    """:func:`display_meshes` (conforming) of one patch set with everything that depends on
+    the geometry only worked out once: the viewer's shot-by-shot job redraws the same patches
+    after every chunk of shots, so each update is a few scatter-adds over (patch, vertex)
+    pairs instead of Python loops over patches. ``meshes(radiance)`` equals
+    ``display_meshes(patches, radiance)`` to rounding (tests/radiosity/test_radiosity_display.py).
+    """
+
+    def __init__(self, patches: PatchSet):
+        self.patches = patches
+        self.parts: list[tuple] = []      # ("quad", plan dict) | ("mesh", index, members)
+        owners = []
+        for index, surface in enumerate(patches.surfaces):
+            members = np.flatnonzero(patches.surface == index)
+            if len(members) == 0:
+                continue
+            if surface.kind == "quad":
+                self.parts.append(("quad", _quad_plan(patches, index, members)))
+            else:
+                self.parts.append(("mesh", index, members))
+            owners.append(index)
+        self.bare = not patches.surfaces
+        self.groups = None
+        if not self.bare:
+            probe = [(_plan_vertices(part), None, None) if part[0] == "quad"
+                     else (patches.surfaces[part[1]].vertices, None, None)
+                     for part in self.parts]
+            self.groups = _coplanar_groups(patches, owners, probe)
+
+    def meshes(self, radiance: np.ndarray) -> list[Mesh]:
+        radiance = np.asarray(radiance, np.float64)
+        if self.bare:
+            return [_bare_display(self.patches, radiance)]
+        out = []
+        for part in self.parts:
+            if part[0] == "quad":
+                out.append(_quad_values(part[1], radiance))
+            else:
+                out.append(_mesh_display(self.patches, part[1], part[2], radiance))
+        if self.groups is not None:
+            _apply_groups(self.groups, out)
+        return out
+
+
+def _plan_vertices(part) -> np.ndarray:
+    return part[1]["vertices"]
+
+
+def _quad_plan(patches: PatchSet, index: int, members: np.ndarray) -> dict:
+    """What :func:`_quad_display` (conforming) computes from the geometry alone."""
+    surface = patches.surfaces[index]
+    rects = patches.rects[members]
+    areas = patches.areas[members]
+    corners = np.concatenate([rects[:, [0, 1]], rects[:, [2, 1]], rects[:, [2, 3]],
+                              rects[:, [0, 3]]])
+    points, inverse = np.unique(corners, axis=0, return_inverse=True)
+    inverse = inverse.reshape(4, len(members)).T
+    px, py = points[:, 0][None, :], points[:, 1][None, :]
+    inside = ((px >= rects[:, 0:1]) & (px <= rects[:, 2:3]) & (py >= rects[:, 1:2])
+              & (py <= rects[:, 3:4]))
+    leaf, vert = np.nonzero(inside)
+    total = np.maximum(np.bincount(vert, areas[leaf], len(points)), 1e-300)
+    # boundary extrapolation: (vertex b, opposite corner o, leaf k) triples
+    extent = (surface.grid[0] * FINE, surface.grid[1] * FINE)
+    x, y = points[:, 0], points[:, 1]
+    boundary = (x == 0) | (y == 0) | (x == extent[0]) | (y == extent[1])
+    kk = np.repeat(np.arange(len(members)), 4)
+    bb = inverse.ravel()
+    oo = inverse[:, [2, 3, 0, 1]].ravel()
+    keep = boundary[bb] & ~boundary[oo]
+    kk, bb, oo = kk[keep], bb[keep], oo[keep]
+    ext_weight = np.bincount(bb, areas[kk], len(points))
+    vertices = surface.point(points[:, 0], points[:, 1])
+    faces, extra_v, extra_corners = [], [], []
+    for k in range(len(members)):
+        x0, y0, x1, y1 = rects[k]
+        on_edge = np.flatnonzero(inside[k] & ((px[0] == x0) | (px[0] == x1) | (py[0] == y0)
+                                              | (py[0] == y1)))
+        a, b, c, d = inverse[k]
+        if len(on_edge) == 4:
+            faces += [(a, b, c), (a, c, d)]
+            continue
+        order = on_edge[np.argsort(_perimeter(points[on_edge], x0, y0, x1, y1))]
+        centre = len(points) + len(extra_v)
+        extra_v.append(surface.point(np.array((x0 + x1) / 2.0), np.array((y0 + y1) / 2.0)))
+        extra_corners.append((a, b, c, d))
+        faces += [(centre, int(order[m]), int(order[(m + 1) % len(order)]))
+                  for m in range(len(order))]
+    if extra_v:
+        vertices = np.concatenate([vertices, np.asarray(extra_v)])
+    return {"members": members, "areas": areas, "leaf": leaf, "vert": vert, "total": total,
+            "n_points": len(points), "corners": inverse, "kk": kk, "bb": bb, "oo": oo,
+            "ext_weight": ext_weight, "vertices": vertices,
+            "faces": np.asarray(faces, np.int64).reshape(-1, 3),
+            "extra_corners": np.asarray(extra_corners, np.int64).reshape(-1, 4)}
+
+
+def _scatter(index: np.ndarray, values: np.ndarray, size: int) -> np.ndarray:
+    """(size, 3): the rows of ``values`` summed into ``index``."""
+    return np.stack([np.bincount(index, values[:, c], size) for c in range(3)], axis=1)
+
+
+def _quad_values(plan: dict, radiance: np.ndarray) -> Mesh:
+    """:func:`_quad_display`'s vertex values from a :func:`_quad_plan`."""
+    rad = radiance[plan["members"]]
+    areas, leaf, vert, total = plan["areas"], plan["leaf"], plan["vert"], plan["total"]
+    n = plan["n_points"]
+    weighted = areas[leaf, None] * rad[leaf]
+    values = _scatter(vert, weighted, n) / total[:, None]
+    kk, bb, oo, w = plan["kk"], plan["bb"], plan["oo"], plan["ext_weight"]
+    if len(kk):
+        ext = _scatter(bb, areas[kk, None] * (2.0 * rad[kk] - values[oo]), n)
+        done = w > 0
+        values = values.copy()
+        values[done] = np.maximum(ext[done] / w[done, None], 0.0)
+    corners = plan["corners"]
+    for _ in range(RECONSTRUCTION_SWEEPS):
+        residual = rad - values[corners].mean(axis=1)
+        values = np.maximum(values + _scatter(vert, areas[leaf, None] * residual[leaf], n)
+                            / total[:, None], 0.0)
+    if len(plan["extra_corners"]):
+        values = np.concatenate([values, values[plan["extra_corners"]].mean(axis=1)])
+    return plan["vertices"], plan["faces"], values
+
+
+def _coplanar_groups(patches: PatchSet, owners: list[int], meshes: list) -> tuple | None:
+    """The vertex groups :func:`_share_coplanar_vertices` averages: (mesh offsets, member
+    positions in the concatenated values, group id per member, group count)."""
+    keys, where = [], []
+    span = float(np.ptp(patches.polygons.reshape(-1, 3), axis=0).max()) or 1.0
+    offsets = np.cumsum([0] + [len(m[0]) for m in meshes])
+    for m, index in enumerate(owners):
+        surface = patches.surfaces[index]
+        if surface.kind != "quad":
+            continue
+        normal = patches.normals[np.flatnonzero(patches.surface == index)[0]]
+        q = np.round(meshes[m][0] / (span * 1e-7)).astype(np.int64)
+        nk = tuple(np.round(normal * 1e4).astype(np.int64))
+        for v in range(len(q)):
+            keys.append((surface.material, *nk, *q[v]))
+            where.append((m, v))
+    groups: dict[tuple, list] = {}
+    for key, item in zip(keys, where, strict=True):
+        groups.setdefault(key, []).append(item)
+    members, gid, g = [], [], 0
+    for items in groups.values():
+        if len({m for m, _ in items}) < 2:
+            continue
+        g += 1
+        for m, v in items:
+            members.append(offsets[m] + v)
+            gid.append(g - 1)
+    if not members:
+        return None
+    gid = np.asarray(gid, np.int64)
+    return offsets, np.asarray(members, np.int64), gid, int(gid.max()) + 1
+
+
+def _apply_groups(groups: tuple, meshes: list) -> None:
+    offsets, members, gid, count = groups
+    values = np.concatenate([m[2] for m in meshes])
+    sums = _scatter(gid, values[members], count)
+    sizes = np.bincount(gid, minlength=count)
+    values[members] = sums[gid] / sizes[gid, None]
+    for m in range(len(meshes)):
+        meshes[m] = (meshes[m][0], meshes[m][1], values[offsets[m]:offsets[m + 1]])

@@ -217,8 +217,14 @@ class Hemicube:
         res = self.res
         top_df, side_df = hemicube_delta_factors(res)
         sides = [atlas[res - res // 2:, f * res:(f + 1) * res] for f in range(1, 5)]
+        n = len(self.patches)
+        seen = atlas >= 0      # the row from this very atlas (one render, not two)
+        row = np.bincount(atlas[seen], weights=self.weights[seen], minlength=n)[:n]
+        if self.eyes.shape[1] > 1:   # several hemicubes per patch: the row is their mean
+            row = self.rows(np.array([i]))[0]
+        row[i] = 0.0
         return {"top": atlas[:, :res], "sides": sides, "top_dF": top_df, "side_dF": side_df,
-                "row": self.rows(np.array([i]))[0]}
+                "row": row}
 
     def release(self) -> None:
         for obj in (self.vao, self.vbo, self.fbo, self.color, self.depth):

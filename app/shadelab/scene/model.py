@@ -254,6 +254,10 @@ class RadiositySettings(Checked):
     hemicube_resolution: int = spec(128, "int", 4, 4096, doc="hemicube face resolution")
     iterations: int = spec(200, "int", 1, 1000000, doc="maximum solver iterations")
     tolerance: float = spec(1e-4, "float", 0.0, 1.0, doc="relative residual to stop at")
+    ambient: bool = spec(True, "bool", doc="the viewer's shot-by-shot display adds "
+                                          "progressive refinement's ambient estimate of the "
+                                          "light not yet shot (Cohen et al. 1988); false: "
+                                          "only the light shot so far")
 
 
 @dataclass

@@ -235,8 +235,9 @@ class Viewer:
         # rect can hide them
         presenter.draw_viewport_extras(state, origin, size, self.recorder.redrawn, band)
         presenter.draw_lesson_buttons(state, origin, size, band)
-        if not state.view.compare:
+        if not state.view.compare and not pipeline_viewport.hides_gizmos(state):
             gizmos.draw(state, origin, size)
+        pipeline_viewport.draw_on_top(state, origin, size)   # the shooting patch, over all
         self.recorder.viewport_shown = True
         if state.error:
             imgui.set_cursor_pos(imgui.ImVec2(12, 40))

@@ -19,6 +19,8 @@ from shadelab.ui.pipelines import (
     OFFLINE,
     PIPELINES,
     RASTER,
+    SHOOTER_ABGR,
+    SHOOTER_HALO,
     current,
     draw_ray_tree,
     label,
@@ -26,7 +28,7 @@ from shadelab.ui.pipelines import (
     pick_ray_tree,
     poll,
     prefetch_tick,
-    shooter_lines,
+    shooter_outline,
     status_line,
     sync,
     track_side_panel_job,
@@ -102,6 +104,38 @@ def draw(viewer: ViewportHost, display_size: tuple[int, int]) -> bool:
     return True
 
 
+def hides_gizmos(state) -> bool:
+    """The radiosity pipeline lights with emitters and the lights it uses: a light it does
+    not use (a raster stand-in for the ceiling quad) has no gizmo there, where it would cover
+    the shooting patch."""
+    if current(state) != "radiosity" or state.view.compare:
+        return False
+    from shadelab.radiosity.direct import direct_lights
+
+    return not direct_lights(state.scene)
+
+
+def draw_on_top(state, origin, display_size: tuple[int, int]) -> None:
+    """After the gizmos: the shooting patch's outline, so nothing hides it."""
+    view = state.view.pipeline_view
+    if view is None or current(state) != "radiosity" or state.view.compare \
+            or view.name != "radiosity" or view.shooter is None or view.stats.get("done"):
+        return
+    outline = shooter_outline(state.scene, display_size, view.shooter)
+    if outline is None:
+        return
+    thick = 5.0 if state.view.presenter else 3.0
+    draw_list = imgui.get_window_draw_list()
+    points = [imgui.ImVec2(origin.x + x, origin.y + y) for x, y in outline]
+    draw_list.add_polyline(points, SHOOTER_HALO, thick + 4.0, imgui.ImDrawFlags_.closed)
+    draw_list.add_polyline(points, SHOOTER_ABGR, thick, imgui.ImDrawFlags_.closed)
+    index = view.stats.get("shooter_index")
+    if index is not None:   # named just below its outline
+        low = outline[:, 1].max() + thick + 4.0
+        label(draw_list, imgui.ImVec2(origin.x + float(outline[:, 0].min()), origin.y + low),
+              f"shooting: patch {index}")
+
+
 def _v(name: str, end: int) -> float:
     """The texture's v at the top (end 0) / bottom (1): GL panes are bottom-up, and the
     offline images are uploaded bottom-up too, so one image call shows them all."""
@@ -129,12 +163,19 @@ def _texture(viewer: ViewportHost, name: str, size: tuple[int, int], offline: li
     if name == "radiosity":
         if view.soup is None or view.name != "radiosity":
             return None
+        # drawn again only when the triangles, the camera or a toggle changed: an idle frame
+        # of the slide does no work proportional to the patches (issue 19.1)
+        soup = viewport_soup(state, view.soup)
+        grid = state.view.show_wireframe or state.view.radiosity_patches
+        key = (view.version, id(soup), size, id(state.scene), state.scene_version,
+               state.scene.version, grid, exposure, vp.line_width)
+        if view.raster_key.get(name) == key and "pipeline_radiosity" in vp.panes:
+            return vp.panes["pipeline_radiosity"].display
+        view.raster_key[name] = key
         pane = vp.pane("pipeline_radiosity", size)
-        vp.draw_colored_triangles(pane, state.scene, viewport_soup(state, view.soup))
-        if state.view.show_wireframe or state.view.radiosity_patches:
+        vp.draw_colored_triangles(pane, state.scene, soup)
+        if grid:
             vp.draw_lines(pane, patch_edges(view.soup), exposure)
-        if view.shooter is not None and not view.stats.get("done"):
-            vp.draw_lines(pane, shooter_lines(view.shooter), exposure, depth_test=False)
         return vp.present(pane, exposure)
     shading, visibility = RASTER[name]
     key = (id(state.scene), state.scene_version, state.scene.version, size, name)

@@ -40,7 +40,8 @@ OFFLINE = {name: pipeline_jobs.pipeline_job(name) for name in OFFLINE_NAMES}
 HOVER_COLOR = 0xFF00FFFF   # the ray hovered in the Ray tree window
 RAY_COLORS = {"primary": 0xFFFFFFFF, "reflected": 0xFF30D0FF, "refracted": 0xFFFFB040,
               "shadow": 0xFF40FF40, "blocked": 0xFF4040FF}   # ImGui ABGR
-SHOOTER_COLOR = (1.0, 0.9, 0.1)
+SHOOTER_ABGR = 0xFF10E6FF    # the shooting patch's outline: bright yellow ...
+SHOOTER_HALO = 0xFF000000    # ... on a black halo, visible on any wall
 PATCH_EDGE_COLOR = (0.02, 0.02, 0.02)
 
 
@@ -235,7 +236,8 @@ def _start(state: AppState, name: str, scene, size) -> None:
 
 
 class _StepGate:
-    """Runs a radiosity job one shot per :meth:`step` (a thread job; the UI presses Step)."""
+    """Runs a radiosity job one shot per :meth:`step` (a thread job; the UI presses Step): the
+    first shot comes at once, each press lets the next one through."""
 
     def __init__(self, cancelled) -> None:
         import threading
@@ -248,6 +250,9 @@ class _StepGate:
 
     def wrap(self, gen):
         for item in gen:
+            if "shots" not in (item.stats or {}):   # meshing, form factors: no shot to wait for
+                yield item
+                continue
             while not self.allowed.acquire(timeout=0.05):
                 if self.cancelled.is_set():
                     return
@@ -367,15 +372,13 @@ def patch_edges(soup: np.ndarray) -> np.ndarray:
     return out.reshape(-1, 6)
 
 
-def shooter_lines(polygon: np.ndarray) -> np.ndarray:
-    """The shooting patch's outline and diagonals, bright yellow."""
-    p = np.asarray(polygon, np.float32)
-    pairs = [(0, 1), (1, 2), (2, 3), (3, 0), (0, 2), (1, 3)]
-    out = np.empty((len(pairs), 2, 6), np.float32)
-    for k, (a, b) in enumerate(pairs):
-        out[k, 0, :3], out[k, 1, :3] = p[a], p[b]
-    out[:, :, 3:] = np.asarray(SHOOTER_COLOR) * 1e3   # bright at any exposure (clamped)
-    return out.reshape(-1, 6)
+def shooter_outline(scene, size: tuple[int, int], polygon: np.ndarray) -> np.ndarray | None:
+    """The shooting patch's corners in viewport pixels (4, 2), drawn as a thick bright
+    outline over everything (None when a corner is behind the eye)."""
+    xy, front = project(scene, size, np.asarray(polygon, float).reshape(-1, 3))
+    if not front.all():
+        return None
+    return xy
 
 
 def label(draw_list, pos, text: str, wrap: float = -1.0) -> None:
@@ -399,7 +402,13 @@ def status_line(state: AppState) -> str:
     if runner is not None and runner.error:
         word = f"failed: {runner.error}"
     elapsed = runner.elapsed if runner is not None else 0.0
-    return f"{LABELS[name]}: {word}  {view.message}  {elapsed:.1f} s"
+    message = view.message
+    if name == "radiosity" and "shots" in view.stats and not (runner and runner.error):
+        # one short line over the room's ceiling, where the light patch shoots first
+        unshot = view.history.get("unshot") or [float("nan")]
+        done = "done: " if view.stats.get("done") else ""
+        message = f"{done}shot {view.stats['shots']}, unshot {100.0 * unshot[-1]:.2f} %"
+    return f"{LABELS[name]}: {word}  {message}  {elapsed:.1f} s"
 
 
 def pick_ray_tree(state: AppState, name: str, pixel, display_size) -> None:

@@ -177,7 +177,9 @@ def draw_pipeline_figures(state: AppState) -> None:
         return
     name = pipelines.current(state)
     if name == "radiosity":
-        _draw_radiosity_stepper(view)
+        from shadelab.ui.radiosity_view import draw_radiosity_stepper
+
+        draw_radiosity_stepper(view)
     if name == "radiosity" and view.history.get("iteration"):
         _draw_residual_plot(view)
     if name == "raytrace":
@@ -188,40 +190,18 @@ def draw_pipeline_figures(state: AppState) -> None:
         draw_ray_tree_table(state, view)
 
 
-def _draw_radiosity_stepper(view) -> None:
-    """Play (shots stream) or step: one shot per press, the shooting patch highlighted."""
-    imgui.text("Progressive refinement:")
-    imgui.same_line()
-    if imgui.small_button("Play" if view.step_mode else "Restart"):
-        view.step_mode, view.key = False, None   # a new job, shots streaming
-    imgui.same_line()
-    if not view.step_mode:
-        if imgui.small_button("Step mode"):
-            view.step_mode, view.key = True, None
-        return
-    gate = view.stats.get("gate")
-    imgui.begin_disabled(gate is None or not view.runner.running)
-    if imgui.small_button("Shoot next patch"):
-        gate.step()
-    imgui.end_disabled()
-
-
 def _draw_residual_plot(view) -> None:
-    import numpy as np
     from imgui_bundle import implot
 
-    h = view.history
-    x = np.asarray(h["iteration"], np.float64)
-    unshot = np.asarray(h["unshot"], np.float64)
-    residual = np.asarray(h["residual"], np.float64)
-    y, label = (unshot, "unshot energy") if np.isnan(residual).all() else (residual, "residual")
-    keep = np.isfinite(y) & (y > 0)
+    from shadelab.ui.radiosity_view import convergence_series
+
+    x, y, label = convergence_series(view.history)
     if implot.begin_plot("radiosity convergence", plot_size(11.0)):
-        implot.setup_axes("shot / iteration", label, implot.AxisFlags_.auto_fit,
-                          implot.AxisFlags_.auto_fit)
+        implot.setup_axes("shots" if "unshot" in label else "iterations", label,
+                          implot.AxisFlags_.auto_fit, implot.AxisFlags_.auto_fit)
         implot.setup_axis_scale(implot.ImAxis_.y1, implot.Scale_.log10)
-        if keep.any():
-            implot.plot_line(label, x[keep], y[keep])
+        if x is not None and len(x):
+            implot.plot_line(label, x, y)
         implot.end_plot()
     shooter = view.stats.get("shooter_index")
     imgui.text_wrapped(f"{view.stats.get('patches', 0)} patches, {view.stats.get('shots', 0)} shots"
@@ -292,13 +272,12 @@ def draw_radiosity_controls(state: AppState) -> bool:
     edited |= combo("form factors", r, "form_factors", ("hemicube", "raycast", "analytic"))
     if r.form_factors == "hemicube":
         edited |= int_field("hemicube resolution", r, "hemicube_resolution")
-        imgui.text_colored(DIM_COLOR, "viewport pipeline: ray-cast (the GPU hemicube needs "
-                                      "the viewer's GL context)")
     edited |= combo("solver", r, "solver", RADIOSITY_SOLVERS)
     edited |= int_field("iterations", r, "iterations")
     edited |= float_slider("tolerance", r, "tolerance", 1e-7, 0.1, log=True, fmt="%.2g")
     _, state.view.radiosity_patches = imgui.checkbox("draw patches (radiosity pipeline)",
                                                      state.view.radiosity_patches)
+    edited |= checkbox("ambient estimate (progressive)", r, "ambient")
     return edited
 
 
