@@ -314,17 +314,21 @@ def solver_steps(scene: Scene, mesh: PatchSet, ff: FormFactors, solver: str, sta
                  emission: np.ndarray | None = None, row=None):
     """The one driver of both ways to watch radiosity (``iter_radiosity`` and the viewer's
     :func:`shadelab.pipelines.radiosity.pipeline_radiosity`): the right-hand side E (emitters
-    plus the lights' first shot, :func:`sources`), then, for a gathering solver, the form
-    factors (yielding progress in the first 60 % of ``band``) and the solvability check;
-    returns the solver's :class:`Step` iterator. Only how the steps are streamed differs.
-    ``rho``, ``emission``: the current materials (default: the mesh's own); ``row``: the
-    progressive solver's row function (default ``ff.row``)."""
+    plus the lights' first shot, :func:`sources`), the form factors (yielding progress in the
+    first 60 % of ``band``) and the solvability check; returns the solver's :class:`Step`
+    iterator. Only how the steps are streamed differs.
+
+    Every solver reads the one matrix: ray-cast and analytic factors are computed once per
+    pair from the smaller patch and made reciprocal (:meth:`FormFactors.matrix`), so
+    progressive refinement shoots through the same F that Gauss-Seidel gathers with -- a row
+    on demand would integrate over the shooter (often the large emitter), cost twice the
+    pairs and solve a slightly different system (Cornell, 1029 patches: 6.4 s against
+    1.9 s). ``rho``, ``emission``: the current materials (default: the mesh's own); ``row``:
+    the progressive solver's row function (default ``ff.row``, the matrix's rows once it is
+    computed; the viewer wraps it to learn the shooter)."""
     settings = scene.radiosity
     rho = mesh.rho if rho is None else rho
     E = sources(scene, mesh, stats=stats, rho=rho, emission=emission)
-    if solver == "progressive":
-        return run_solver(solver, None, rho, E, settings.iterations, settings.tolerance,
-                          row=row or ff.row, areas=mesh.areas)
     t0 = time.perf_counter()
     span = band[1] - band[0]
     for done in ff.iter_matrix():
@@ -333,6 +337,9 @@ def solver_steps(scene: Scene, mesh: PatchSet, ff: FormFactors, solver: str, sta
     F = ff.matrix()
     stats["form_factors_s"] = time.perf_counter() - t0
     check_solvable(F, rho, lambda: _rho_names(scene, mesh))
+    if solver == "progressive":
+        return run_solver(solver, None, rho, E, settings.iterations, settings.tolerance,
+                          row=row or ff.row, areas=mesh.areas)
     return run_solver(solver, F, rho, E, settings.iterations, settings.tolerance,
                       areas=mesh.areas)
 
@@ -347,8 +354,7 @@ def _solve_stage(scene, mesh, method, solver, resolution, size, image_every, sta
     span = band[1] - band[0]
     steps = yield from solver_steps(scene, mesh, ff, solver, stats, band)
     last = yield from _drive(scene, mesh, steps, history, stats, size, image_every, start,
-                             (band[0] + 0.6 * span if solver != "progressive" else band[0],
-                              band[1]))
+                             (band[0] + 0.6 * span, band[1]))
     stats["solve_s"] = last.seconds
     value = last.unshot if np.isnan(last.residual) else last.residual
     stats["converged"] = bool(value <= settings.tolerance) or solver == "direct"
