@@ -163,9 +163,14 @@ def _build_rays(pairs, recv, src, src_w, normals, areas, rays, eps):
             x2 = recv[i, k, 2] + eps * normals[i, 2]
             count = 0
             for ell in range(s_count):
-                w, _, _, _ = _wallace(x0, x1, x2, normals[i], src[j, ell, 0], src[j, ell, 1],
-                                      src[j, ell, 2], normals[j], areas[j] * src_w[j, ell])
-                if w > 0.0:
+                # Wallace's weight is > 0 exactly where the sample is in front of both
+                # patches (and has area): two signs, no square root
+                d0 = src[j, ell, 0] - x0
+                d1 = src[j, ell, 1] - x1
+                d2 = src[j, ell, 2] - x2
+                if (d0 * normals[i, 0] + d1 * normals[i, 1] + d2 * normals[i, 2] > 0.0
+                        and d0 * normals[j, 0] + d1 * normals[j, 1] + d2 * normals[j, 2] < 0.0
+                        and src_w[j, ell] > 0.0):
                     front[count] = ell
                     count += 1
             for q in range(rays):
@@ -183,17 +188,56 @@ def _build_rays(pairs, recv, src, src_w, normals, areas, rays, eps):
 
 
 @numba.njit(cache=True)
+def _crosses_box(polygons, i, j, d, lo, hi, pad):
+    """Does the shaft between patches i and j (the convex hull of their 8 corners) meet a
+    plane inside the box [lo, hi] (a planar surface's)? ``d`` (8,): the corners' signed
+    distances to the plane. The hull's section by the plane is the convex hull of the points
+    where corner-to-corner segments of opposite sides cross it (and of the corners on it):
+    their bounding box, padded by ``pad``, against the box."""
+    c_lo = np.full(3, np.inf)
+    c_hi = np.full(3, -np.inf)
+    for q in range(8):
+        if d[q] < 0.0:
+            continue
+        pq = i if q < 4 else j
+        if d[q] == 0.0:
+            for c in range(3):
+                c_lo[c] = min(c_lo[c], polygons[pq, q % 4, c])
+                c_hi[c] = max(c_hi[c], polygons[pq, q % 4, c])
+            continue
+        for r in range(8):
+            if d[r] >= 0.0:
+                continue
+            pr = i if r < 4 else j
+            t = d[q] / (d[q] - d[r])
+            for c in range(3):
+                x = polygons[pq, q % 4, c] + t * (polygons[pr, r % 4, c]
+                                                  - polygons[pq, q % 4, c])
+                c_lo[c] = min(c_lo[c], x)
+                c_hi[c] = max(c_hi[c], x)
+    for c in range(3):
+        if c_hi[c] + pad < lo[c] or c_lo[c] - pad > hi[c]:
+            return False
+    return True
+
+
+@numba.njit(cache=True)
 def _blockable(pairs, polygons, surface_of, planes, planar, lo, hi, eps):
     """Shaft culling (after Haines & Wallace 1991): can any surface block patch i from j?
 
     A surface can only if the box around both patches meets its box and, when it is
-    planar, the two patches are not both in front of (or both behind) its plane. Patch sets
-    without surfaces (one surface 0 for all) keep every pair.
+    planar, the two patches are not both in front of (or both behind) its plane and the
+    shaft between them crosses that plane inside the surface's box (:func:`_crosses_box`).
+    Culled pairs are those no ray between them can hit, so the matrix is the same with
+    fewer rays (Cornell, 1029 patches: 4.4 M rays -> 3.4 M). Patch sets without surfaces
+    (one surface 0 for all) keep every pair.
     """
     out = np.zeros(len(pairs), np.bool_)
     count = len(planes)
+    pad = 100.0 * eps  # rays start and end eps off the patches
     blo = np.empty(3)
     bhi = np.empty(3)
+    d = np.empty(8)
     for p in range(len(pairs)):
         i, j = pairs[p, 0], pairs[p, 1]
         for c in range(3):
@@ -211,18 +255,77 @@ def _blockable(pairs, polygons, surface_of, planes, planar, lo, hi, eps):
                 continue
             if planar[s] and count > 1:
                 above = below = False
-                for q in (i, j):
-                    for k in range(4):
-                        d = (planes[s, 0] * polygons[q, k, 0] + planes[s, 1] * polygons[q, k, 1]
-                             + planes[s, 2] * polygons[q, k, 2] + planes[s, 3])
-                        if d > eps:
-                            above = True
-                        elif d < -eps:
-                            below = True
+                for q in range(8):
+                    patch = i if q < 4 else j
+                    k = q % 4
+                    d[q] = (planes[s, 0] * polygons[patch, k, 0]
+                            + planes[s, 1] * polygons[patch, k, 1]
+                            + planes[s, 2] * polygons[patch, k, 2] + planes[s, 3])
+                    if d[q] > eps:
+                        above = True
+                    elif d[q] < -eps:
+                        below = True
                 if not (above and below):
+                    continue
+                if not _crosses_box(polygons, i, j, d, lo[s], hi[s], pad):
                     continue
             out[p] = True
             break
+    return out
+
+
+@numba.njit(cache=True)
+def _seen_pairs(kernel, rows):
+    """(pairs (P, 2) of (patch i, patch j), a (P,) the block row of i) where some receiver
+    point of i sees j (kernel > 0)."""
+    count = 0
+    for a in range(kernel.shape[0]):
+        for j in range(kernel.shape[1]):
+            for k in range(kernel.shape[2]):
+                if kernel[a, j, k] > 0.0:
+                    count += 1
+                    break
+    pairs = np.empty((count, 2), np.int64)
+    block = np.empty(count, np.int64)
+    p = 0
+    for a in range(kernel.shape[0]):
+        for j in range(kernel.shape[1]):
+            for k in range(kernel.shape[2]):
+                if kernel[a, j, k] > 0.0:
+                    pairs[p, 0], pairs[p, 1], block[p] = rows[a], j, a
+                    p += 1
+                    break
+    return pairs, block
+
+
+@numba.njit(cache=True)
+def _apply_visibility(kernel, a, j, hit, weights, rays):
+    """kernel[a, j, k] *= seen / total of the Wallace weights of point k's rays (a point
+    whose rays all have weight 0 keeps its kernel: it is a sliver)."""
+    k_count = kernel.shape[2]
+    r = 0
+    for p in range(len(a)):
+        for k in range(k_count):
+            seen = total = 0.0
+            for _ in range(rays):
+                total += weights[r]
+                if not hit[r]:
+                    seen += weights[r]
+                r += 1
+            if total > 0.0:
+                kernel[a[p], j[p], k] *= seen / max(total, 1e-300)
+
+
+@numba.njit(cache=True)
+def _integrate(kernel, weights):
+    """(rows, N): sum_k kernel[a, j, k] * weights[a, k] (the receiver quadrature)."""
+    out = np.zeros((kernel.shape[0], kernel.shape[1]))
+    for a in range(kernel.shape[0]):
+        for j in range(kernel.shape[1]):
+            total = 0.0
+            for k in range(kernel.shape[2]):
+                total += kernel[a, j, k] * weights[a, k]
+            out[a, j] = total
     return out
 
 
@@ -328,33 +431,27 @@ class FormFactors:
         p = self.patches
         kernel = _unoccluded(rows, p.polygons, p.normals, self._recv, self.eps, p.areas, half)
         if self.method == "raycast":
-            kernel = kernel * self._visibility(rows, kernel)
-        return np.einsum("ajk,ak->aj", kernel, self._recv_w[rows])
+            self._visibility(rows, kernel)
+        return _integrate(kernel, self._recv_w[rows])
 
-    def _visibility(self, rows: np.ndarray, kernel: np.ndarray) -> np.ndarray:
-        """Wallace-weighted visible share per receiver point (len(rows), N, K)."""
+    def _visibility(self, rows: np.ndarray, kernel: np.ndarray) -> None:
+        """Multiply the per-point kernels (len(rows), N, K) by their Wallace-weighted visible
+        share, in place (pairs no surface can come between keep 1)."""
         p = self.patches
         if self._src is None:
             self._src, self._src_w = source_samples(p.polygons)
-        a, j = np.nonzero(kernel.max(axis=2) > 0.0)
-        vis = np.ones_like(kernel)
+        pairs, a = _seen_pairs(kernel, rows)
         if len(a) == 0:
-            return vis
-        pairs = np.stack([rows[a], j], axis=1).astype(np.int64)
+            return
         # Shaft culling: rays only where some surface could stand between the two patches
         blockable = _blockable(pairs, p.polygons, p.surface, *self._occluders())
-        a, j, pairs = a[blockable], j[blockable], pairs[blockable]
+        a, pairs = a[blockable], pairs[blockable]
         if len(a) == 0:
-            return vis
+            return
         origins, dirs, weights = _build_rays(pairs, self._recv, self._src, self._src_w,
                                              p.normals, p.areas, self.rays, self.eps)
         hit = self._occluded(origins, dirs)
-        k_count = self._recv.shape[1]
-        weights = weights.reshape(len(pairs), k_count, self.rays)
-        seen = np.where(hit.reshape(weights.shape), 0.0, weights).sum(axis=2)
-        total = weights.sum(axis=2)
-        vis[a, j] = np.where(total > 0.0, seen / np.maximum(total, 1e-300), 1.0)
-        return vis
+        _apply_visibility(kernel, a, pairs[:, 1], hit, weights, self.rays)
 
     def _occluders(self):
         """Per surface: plane (n, d) if planar, and its bounding box (padded by eps)."""
