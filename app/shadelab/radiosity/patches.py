@@ -258,9 +258,7 @@ def uniform_patches(scene: Scene, count: int) -> PatchSet:
     surfaces = scene_surfaces(scene)
     if not surfaces:
         raise ShadeLabError("objects: the scene has no surfaces to mesh into patches")
-    mesh_faces = sum(len(s.faces) for s in surfaces if s.kind == "mesh")
-    quads = sum(1 for s in surfaces if s.kind == "quad")
-    if mesh_faces and mesh_faces + quads > count:
+    if needs_clustering(surfaces, count):
         return _clustered_patches(scene, surfaces, count)
     total = sum(_surface_area(s) for s in surfaces)
     # Find the patch size h whose meshing comes closest to the target count (bisection on log h)
@@ -290,39 +288,59 @@ def uniform_patches(scene: Scene, count: int) -> PatchSet:
     return assemble(scene, surfaces, leaves)
 
 
+def needs_clustering(surfaces: list[Surface], count: int) -> bool:
+    """Would one patch per mesh triangle (and one cell per quad) exceed ``count``?"""
+    mesh_faces = sum(len(s.faces) for s in surfaces if s.kind == "mesh")
+    quads = sum(1 for s in surfaces if s.kind == "quad")
+    return bool(mesh_faces) and mesh_faces + quads > count
+
+
+def cluster_surfaces(surfaces: list[Surface], count: int) -> int:
+    """Cluster every mesh surface (in place) to its share of ``count``
+    (:func:`_cluster_targets`); returns the patches left to the quads."""
+    targets = _cluster_targets(surfaces, count)
+    for index, target in targets.items():
+        s = surfaces[index]
+        s.vertices, s.faces = cluster_mesh(s.vertices, s.faces, target)
+    return count - sum(len(surfaces[i].faces) for i in targets)
+
+
+def quad_leaves(surfaces: list[Surface], rest: int) -> list[tuple]:
+    """The regular grid of the coarsest cell size h with at most ``rest`` quad cells (at
+    least one each): sets each quad surface's ``grid``, returns its leaves."""
+    quad_area = sum(_surface_area(s) for s in surfaces if s.kind == "quad")
+    leaves: list[tuple] = []
+    if quad_area <= 0.0:
+        return leaves
+    lo = math.sqrt(quad_area / max(rest, 1)) / 8.0
+    hi = max(math.sqrt(quad_area / max(rest, 1)) * 4.0,
+             max(float(np.ptp(s.corners, axis=0).max()) for s in surfaces
+                 if s.kind == "quad") * 2.0)
+    for _ in range(40):
+        mid = math.sqrt(lo * hi)
+        if _quad_count(surfaces, mid) > rest:
+            lo = mid
+        else:
+            hi = mid
+    for index, s in enumerate(surfaces):
+        if s.kind != "quad":
+            continue
+        s.grid = _quad_grid(s.corners, hi)
+        for i in range(s.grid[0]):
+            for j in range(s.grid[1]):
+                leaves.append((index, i * FINE, j * FINE, (i + 1) * FINE, (j + 1) * FINE))
+    return leaves
+
+
 def _clustered_patches(scene: Scene, surfaces: list[Surface], count: int) -> PatchSet:
     """Meshes clustered to their share of ``count`` (:func:`_cluster_targets`), quads on the
     regular grid of the coarsest size h that fits the rest (at least one cell each)."""
     import time
 
     start = time.perf_counter()
-    targets = _cluster_targets(surfaces, count)
-    triangles_in = sum(len(surfaces[i].faces) for i in targets)
-    for index, target in targets.items():
-        s = surfaces[index]
-        s.vertices, s.faces = cluster_mesh(s.vertices, s.faces, target)
-    rest = count - sum(len(surfaces[i].faces) for i in targets)
-    quad_area = sum(_surface_area(s) for s in surfaces if s.kind == "quad")
-    leaves = []
-    if quad_area > 0.0:
-        lo = math.sqrt(quad_area / max(rest, 1)) / 8.0
-        hi = max(math.sqrt(quad_area / max(rest, 1)) * 4.0,
-                 max(float(np.ptp(s.corners, axis=0).max()) for s in surfaces
-                     if s.kind == "quad") * 2.0)
-        for _ in range(40):
-            mid = math.sqrt(lo * hi)
-            if _quad_count(surfaces, mid) > rest:
-                lo = mid
-            else:
-                hi = mid
-        for index, s in enumerate(surfaces):
-            if s.kind != "quad":
-                continue
-            s.grid = _quad_grid(s.corners, hi)
-            for i in range(s.grid[0]):
-                for j in range(s.grid[1]):
-                    leaves.append((index, i * FINE, j * FINE, (i + 1) * FINE, (j + 1) * FINE))
-    patches = assemble(scene, surfaces, leaves)
+    triangles_in = sum(len(s.faces) for s in surfaces if s.kind == "mesh")
+    rest = cluster_surfaces(surfaces, count)
+    patches = assemble(scene, surfaces, quad_leaves(surfaces, rest))
     patches.info.update(clustered=True, clustering_s=time.perf_counter() - start,
                         mesh_triangles=triangles_in)
     return patches
