@@ -137,15 +137,16 @@ def reference_noise(images: list[np.ndarray], mask: np.ndarray) -> float:
 
 def error_vs_time(scene, size, reference, mask, counts, meshing: str,
                   budget_s: float | None = None) -> list[dict]:
-    """Rows (patches, seconds, error) of uniform-solver runs at increasing patch counts:
-    ``seconds`` is meshing + ray-cast form factors + Gauss-Seidel (the image is not timed);
-    stops after the first run over ``budget_s`` past the budget (to show the trend)."""
+    """Rows (patches, seconds, error) of runs at increasing patch counts: ``seconds`` is
+    meshing + ray-cast form factors + the preset's solver (what ``shadelab radiosity`` runs;
+    the image is not timed); stops after the first run over ``budget_s`` past the budget
+    (to show the trend)."""
     from shadelab.radiosity.solution import solve_scene
 
     rows = []
     for count in counts:
         start = time.perf_counter()
-        solution = solve_scene(scene, count, "raycast", "gauss-seidel", adaptive=False,
+        solution = solve_scene(scene, count, "raycast", None, adaptive=False,
                                meshing=meshing)
         seconds = time.perf_counter() - start
         image = solution.image(size, supersample=SUPERSAMPLE)
@@ -173,7 +174,7 @@ def error_in_budget(scene, quick: bool) -> dict:
     for meshing in ("uniform", "discontinuity"):
         from shadelab.radiosity.solution import solve_scene
 
-        solve_scene(scene, 20, "raycast", "gauss-seidel", adaptive=False, meshing=meshing)
+        solve_scene(scene, 20, "raycast", None, adaptive=False, meshing=meshing)
         if mask is None:
             mask = emitter_ring_mask(solve_scene(scene, 100, adaptive=False, meshing="uniform"),
                                      size)
@@ -185,7 +186,25 @@ def error_in_budget(scene, quick: bool) -> dict:
     return {"radiosity_error_in_2s": min(errors) if errors else None,
             "best_in_2s": best, "goal": 0.015, "budget_s": BUDGET_S, "size": list(size),
             "supersample": SUPERSAMPLE, "reference": info, "error_vs_time": series,
-            "timed": "meshing + ray-cast form factors + Gauss-Seidel, single process"}
+            "defaults": at_defaults(scene, size, reference, mask),
+            "solver": scene.radiosity.solver,
+            "timed": "meshing + ray-cast form factors + the preset's solver, single process"}
+
+
+def at_defaults(scene, size, reference, mask, repeats: int = 3) -> dict:
+    """``shadelab radiosity cornell`` as a user runs it (the preset's patches, meshing,
+    form factors and solver): median seconds of ``repeats`` solves, and the error."""
+    from shadelab.radiosity.solution import solve_scene
+
+    seconds, solution = [], None
+    for _ in range(repeats):
+        start = time.perf_counter()
+        solution = solve_scene(scene)
+        seconds.append(time.perf_counter() - start)
+    image = solution.image(size, supersample=SUPERSAMPLE)
+    return {"patches": len(solution.patches), "meshing": solution.stats["meshing"],
+            "solver": solution.stats["solver"], "seconds": float(np.median(seconds)),
+            "samples_s": seconds, "error": image_error(image, reference, mask)}
 
 
 def time_pathtracer(scene, size, reference, mask, spps, seed: int = 7) -> dict:
