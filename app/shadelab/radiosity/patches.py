@@ -54,6 +54,9 @@ class Surface:
     grid: tuple[int, int] = (1, 1)
     vertices: np.ndarray | None = None
     faces: np.ndarray | None = None
+    original: tuple | None = None  # a clustered mesh's own (vertices, faces, and each
+    #                                vertex's clustered vertex): the display draws these
+
 
     def point(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
         """World points of integer quadtree coordinates (x along u, y along v)."""
@@ -181,16 +184,19 @@ def _count_for(surfaces: list[Surface], h: float) -> int:
     return total
 
 
-def cluster_mesh(vertices: np.ndarray, faces: np.ndarray, target: int
-                 ) -> tuple[np.ndarray, np.ndarray]:
+def cluster_mesh(vertices: np.ndarray, faces: np.ndarray, target: int,
+                 vertex_map: bool = False):
     """At most ``target`` triangles standing for ``faces``: vertex clustering on the finest
     regular grid (bisection on its cell size) that leaves no more; each cell's vertices merge
-    into their mean, collapsed and repeated triangles go. The input when it already fits."""
+    into their mean, collapsed and repeated triangles go. The input when it already fits.
+
+    Returns (vertices, faces); with ``vertex_map`` also (V_in,) the clustered vertex each
+    input vertex merged into (the nearest one where its cell's triangles all collapsed)."""
     vertices = np.asarray(vertices, float)
     faces = np.asarray(faces, np.int64)
     target = max(1, int(target))
     if len(faces) <= target:
-        return vertices, faces
+        return (vertices, faces, np.arange(len(vertices))) if vertex_map else (vertices, faces)
     lo_corner = vertices.min(axis=0)
     extent = max(float(np.ptp(vertices, axis=0).max()), 1e-12)
 
@@ -215,21 +221,33 @@ def cluster_mesh(vertices: np.ndarray, faces: np.ndarray, target: int
             area = np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
             f = f[area > 1e-12 * extent * extent]
         used, f = np.unique(f, return_inverse=True)
-        return merged[used], f.reshape(-1, 3)
+        return merged[used], f.reshape(-1, 3), (used, inverse)
 
     lo = extent / max(math.sqrt(target), 1.0) / 16.0  # fine enough to keep > target
     hi = extent * 1.01  # one cell: no triangle left
     best = clustered(hi)
     for _ in range(CLUSTER_ROUNDS):
         mid = math.sqrt(lo * hi)
-        v, f = clustered(mid)
+        v, f, cells = clustered(mid)
         if len(f) <= target:
-            hi, best = mid, (v, f)
+            hi, best = mid, (v, f, cells)
         else:
             lo = mid
         if hi / lo < 1.01:
             break
-    return best
+    v, f, (used, inverse) = best
+    if not vertex_map:
+        return v, f
+    if len(used) == 0:  # every triangle collapsed: nothing to draw
+        return v, f, np.zeros(len(vertices), np.int64)
+    where = np.searchsorted(used, inverse)
+    found = (where < len(used)) & (used[np.minimum(where, len(used) - 1)] == inverse)
+    out = np.where(found, where, -1)
+    if (~found).any() and len(v):
+        from scipy.spatial import cKDTree
+
+        out[~found] = cKDTree(v).query(vertices[~found])[1]
+    return v, f, np.maximum(out, 0)
 
 
 def _cluster_targets(surfaces: list[Surface], count: int) -> dict[int, int]:
@@ -301,7 +319,10 @@ def cluster_surfaces(surfaces: list[Surface], count: int) -> int:
     targets = _cluster_targets(surfaces, count)
     for index, target in targets.items():
         s = surfaces[index]
-        s.vertices, s.faces = cluster_mesh(s.vertices, s.faces, target)
+        vertices, faces = s.vertices, s.faces
+        s.vertices, s.faces, to_cluster = cluster_mesh(vertices, faces, target, vertex_map=True)
+        if len(s.faces) < len(faces):
+            s.original = (vertices, faces, to_cluster)
     return count - sum(len(surfaces[i].faces) for i in targets)
 
 

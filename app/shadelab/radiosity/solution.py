@@ -75,8 +75,13 @@ class RadiositySolution:
         return self.B / math.pi
 
     def display_meshes(self, conforming: bool = True) -> list[display.Mesh]:
-        """(vertices (V,3), faces (F,3), vertex_radiance (V,3)) per surface, world space."""
-        return display.display_meshes(self.patches, self.radiance, conforming)
+        """(vertices (V,3), faces (F,3), vertex_radiance (V,3)) per surface, world space.
+
+        A clustered mesh is drawn as its own triangles, each vertex with the radiance of the
+        clustered vertex it merged into (:func:`clustered_display`): its silhouette is the
+        raster's, pixel for pixel, and its shading the clusters' radiosity."""
+        meshes = display.display_meshes(self.patches, self.radiance, conforming)
+        return clustered_display(self.patches, self.radiance, meshes)
 
     def image(self, size: tuple[int, int], conforming: bool = True,
               supersample: int = 1) -> np.ndarray:
@@ -91,6 +96,35 @@ class RadiositySolution:
         if s == 1:
             return image
         return image.reshape(size[1], s, size[0], s, 3).mean(axis=(1, 3)).astype(np.float32)
+
+
+def clustered_display(patches: PatchSet, radiance: np.ndarray,
+                      meshes: list[display.Mesh]) -> list[display.Mesh]:
+    """``meshes`` (one per surface with patches, in surface order) with each clustered mesh
+    replaced by its original triangles: a vertex takes the area-weighted radiance of the
+    patches (clustered triangles) around the clustered vertex it merged into."""
+    owners = [i for i, _ in enumerate(patches.surfaces) if np.any(patches.surface == i)]
+    if len(owners) != len(meshes):
+        return meshes
+    out = list(meshes)
+    for m, index in enumerate(owners):
+        surface = patches.surfaces[index]
+        if surface.kind != "mesh" or surface.original is None:
+            continue
+        vertices, faces, to_cluster = surface.original
+        members = np.flatnonzero(patches.surface == index)
+        tri = patches.tri[members]
+        values = np.zeros((len(surface.vertices), 3))
+        weight = np.zeros(len(surface.vertices))
+        for corner in range(3):
+            np.add.at(values, tri[:, corner], radiance[members] * patches.areas[members, None])
+            np.add.at(weight, tri[:, corner], patches.areas[members])
+        mean = (radiance[members] * patches.areas[members, None]).sum(axis=0) \
+            / max(float(patches.areas[members].sum()), 1e-300)
+        values = np.where(weight[:, None] > 0.0, values / np.maximum(weight, 1e-300)[:, None],
+                          mean[None, :])
+        out[m] = (vertices, faces, values[to_cluster])
+    return out
 
 
 # ---------------------------------------------------------------------- checks
