@@ -13,12 +13,22 @@ Lischinski, Tampieri & Greenberg 1992 but kept on the quadtree of :mod:`patches`
   bottom edges on the floor, a wall's edge on the floor): leaves of either surface that
   touch such a segment are split ``CONTACT_LEVELS`` times (an option, off by default: once
   the hidden cells are gone it did not pay on the Cornell box, see below).
+* **near mesh objects** -- quad leaves closer to a mesh object (a scan, a sphere standing
+  on a floor) than ``NEAR_REACH`` of their own size are split, ``NEAR_LEVELS`` times: the
+  floor's cells grade down towards where the object stands, where its contact shadow is
+  (Spot, 100k triangles, on an 8 m floor at 400 patches: the shadowed floor under it 0.095
+  of the lit floor beside it, 0.22 without; ``tests/radiosity/test_radiosity_contact.py``).
+  Distances are to the mesh as loaded (vertices and triangle centroids), not its clusters.
 * **shadow boundaries** -- leaves whose corners (and centre) see different shares of the
-  emitters (ray-cast visibility of a 4 x 4 grid on each light) are split ``SHADOW_LEVELS``
-  times: penumbrae get small patches, fully lit and fully shadowed regions stay coarse.
+  emitters (ray-cast visibility of a 4 x 4 grid on each light) or of the point, spot and
+  directional lights (one shadow ray each, weighted by their irradiance) are split
+  ``SHADOW_LEVELS`` times: penumbrae get small patches, fully lit and fully shadowed
+  regions stay coarse.
 
-The base grid is solved for so that the final patch count comes close to the target.
-Pure numpy + embreex (no GL).
+The base grid is solved for so that the final patch count comes close to the target; a
+scene whose meshes are clustered keeps the budget as a bound (the meshes are clustered
+once, the quads' base grid is the finest whose refined cells fit the rest). Pure numpy,
+scipy's k-d tree + embreex (no GL).
 """
 
 from __future__ import annotations
