@@ -180,3 +180,25 @@ def test11_progressive_matches_the_exact_solve_shot_for_shot(leak):
         np.testing.assert_allclose(step.B, B, rtol=1e-10, atol=1e-12)
         assert step.unshot == pytest.approx((unshot * A[:, None]).sum() / initial, rel=1e-9)
     assert len(shooters) == 300
+
+
+def test12_progressive_shows_its_first_shot_before_the_matrix():
+    """With images asked for, progressive refinement shows the brightest patch's first shot
+    before the form-factor matrix (one row integrated over the shooter, a preview): lit
+    beyond the emitter's own pixels; the solution is the one solved without images."""
+    from shadelab.radiosity.solution import iter_radiosity, solve_scene
+
+    scene = load_preset("radiosity-leak")
+    job = list(iter_radiosity(scene, (24, 24), 80, "raycast", "progressive",
+                              meshing="uniform"))
+    first = next(k for k, p in enumerate(job) if p.image is not None)
+    matrix = next(k for k, p in enumerate(job) if "form factors" in p.message)
+    assert first < matrix
+    solution = job[-1].stats["solution"]
+    emitters = solution.patches.E.max(axis=1) > 0.0
+    lit_only_emitters = type(solution)(scene, solution.patches, solution.patches.E)
+    image, bare = job[first].image, lit_only_emitters.image((24, 24))
+    assert (image.max(axis=2) > 0.0).sum() > (bare.max(axis=2) > 0.0).sum() + 50
+    assert emitters.any()
+    alone = solve_scene(scene, 80, "raycast", "progressive", meshing="uniform")
+    np.testing.assert_array_equal(solution.B, alone.B)

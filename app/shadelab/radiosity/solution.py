@@ -386,6 +386,8 @@ def _solve_stage(scene, mesh, method, solver, resolution, size, image_every, sta
     history = new_history()
     stats["history"] = history
     span = band[1] - band[0]
+    if solver == "progressive" and size is not None and "first_image_s" not in stats:
+        yield _first_shot_preview(scene, mesh, ff, stats, size, start, band[0])
     steps = yield from solver_steps(scene, mesh, ff, solver, stats, band)
     last = yield from _drive(scene, mesh, steps, history, stats, size, image_every, start,
                              (band[0] + 0.6 * span, band[1]))
@@ -397,6 +399,24 @@ def _solve_stage(scene, mesh, method, solver, resolution, size, image_every, sta
     if final:
         yield from _finish(scene, mesh, B, stats, size, start)
     return B
+
+
+def _first_shot_preview(scene, mesh, ff, stats, size, start, fraction) -> Progress:
+    """Progressive refinement's first picture before the matrix exists (Cohen et al. 1988):
+    the brightest patch shot through one row integrated over it (:meth:`FormFactors.row`, a
+    separate engine, so the solve still reads only the reciprocal matrix; a hemicube row is
+    the matrix's own). Only where images are asked for (the viewer, the first-image bench)."""
+    E = sources(scene, mesh)
+    i = int(np.argmax((E * mesh.areas[:, None]).sum(axis=1)))
+    rows = ff if ff.method == "hemicube" else FormFactors(mesh, ff.method, ff.resolution)
+    f = rows.row(i)
+    first = next(run_solver("progressive", None, mesh.rho, E, 1, 0.0, row=lambda _: f,
+                            areas=mesh.areas))
+    solution = RadiositySolution(scene, mesh, first.display_B(mesh.rho), dict(stats))
+    image = solution.image(size)
+    stats["first_image_s"] = time.perf_counter() - start
+    return Progress(image, fraction, f"first shot, a preview ({len(mesh)} patches)",
+                    dict(stats))
 
 
 def _finish(scene, mesh, B, stats, size, start) -> Iterator[Progress]:
