@@ -145,13 +145,14 @@ def error_vs_time(scene, size, reference, mask, counts, meshing: str,
 
     rows = []
     for count in counts:
-        start = time.perf_counter()
+        start, cpu = time.perf_counter(), time.process_time()
         solution = solve_scene(scene, count, "raycast", None, adaptive=False,
                                meshing=meshing)
-        seconds = time.perf_counter() - start
+        seconds, cpu = time.perf_counter() - start, time.process_time() - cpu
         image = solution.image(size, supersample=SUPERSAMPLE)
         rows.append({"target": int(count), "patches": len(solution.patches),
-                     "seconds": seconds, "error": image_error(image, reference, mask)})
+                     "seconds": seconds, "cpu_s": cpu,
+                     "error": image_error(image, reference, mask)})
         if budget_s is not None and seconds > 1.5 * budget_s:
             break
     return rows
@@ -196,15 +197,17 @@ def at_defaults(scene, size, reference, mask, repeats: int = 3) -> dict:
     form factors and solver): median seconds of ``repeats`` solves, and the error."""
     from shadelab.radiosity.solution import solve_scene
 
-    seconds, solution = [], None
+    seconds, cpu, solution = [], [], None
     for _ in range(repeats):
-        start = time.perf_counter()
+        start, cpu_start = time.perf_counter(), time.process_time()
         solution = solve_scene(scene)
         seconds.append(time.perf_counter() - start)
+        cpu.append(time.process_time() - cpu_start)
     image = solution.image(size, supersample=SUPERSAMPLE)
     return {"patches": len(solution.patches), "meshing": solution.stats["meshing"],
             "solver": solution.stats["solver"], "seconds": float(np.median(seconds)),
-            "samples_s": seconds, "error": image_error(image, reference, mask)}
+            "samples_s": seconds, "cpu_s": float(np.median(cpu)),
+            "error": image_error(image, reference, mask)}
 
 
 def time_pathtracer(scene, size, reference, mask, spps, seed: int = 7) -> dict:
