@@ -137,10 +137,12 @@ def reference_noise(images: list[np.ndarray], mask: np.ndarray) -> float:
 
 def error_vs_time(scene, size, reference, mask, counts, meshing: str,
                   budget_s: float | None = None) -> list[dict]:
-    """Rows (patches, seconds, error) of runs at increasing patch counts: ``seconds`` is
-    meshing + ray-cast form factors + the preset's solver (what ``shadelab radiosity`` runs;
-    the image is not timed); stops after the first run over ``budget_s`` past the budget
-    (to show the trend)."""
+    """Rows (patches, seconds, cpu_s, error) of runs at increasing patch counts: ``seconds``
+    is the wall time of meshing + ray-cast form factors + the preset's solver (what
+    ``shadelab radiosity`` runs; the image is not timed), ``cpu_s`` the process's CPU time
+    over the same span (the work is single-threaded: what an idle core takes, readable on a
+    loaded machine); stops after the first run over ``budget_s`` past the budget (to show
+    the trend)."""
     from shadelab.radiosity.solution import solve_scene
 
     rows = []
