@@ -454,14 +454,14 @@ def _near_points(surfaces: list[Surface]):
     """(k-d tree, None) of the mesh surfaces' vertices and triangle centroids, as they are
     before any clustering (a scan's feet, not the cluster they merge into); None without
     meshes."""
-    from scipy.spatial import cKDTree
-
     parts = []
     for s in surfaces:
         if s.kind == "mesh" and len(s.faces):
             parts += [s.vertices, s.vertices[s.faces].mean(axis=1)]
     if not parts:
-        return None
+        return None  # (and scipy, seconds to import, stays out of a room of quads)
+    from scipy.spatial import cKDTree
+
     return cKDTree(np.concatenate(parts)), None
 
 
