@@ -191,3 +191,46 @@ def test_a_hemicube_past_the_gl_limit_is_one_line(gl_ctx, tmp_path, capsys):
     err = capsys.readouterr().err
     assert code == 2 and "hemicube_resolution 4096" in err and "Traceback" not in err
     assert not out.exists()
+
+
+def test12_culling_changes_no_form_factor(monkeypatch):
+    """Shaft culling drops pairs whose shaft crosses no surface inside its box, and casts
+    no rays where one surface stands across the whole shaft (visibility 0): on the Cornell
+    box (its two blocks hide much of the room) the matrix is the one whose every pair is
+    ray-cast, with under 60 % of the rays (measured 1.77 M of 4.40 M at 1029 patches). The
+    only differences are grazing pairs of F ~ 1e-9 whose rays skim a surface (measured
+    1.9e-9 at most): bound 1e-7 of the largest factor."""
+    from shadelab.radiosity import formfactors
+    from shadelab.radiosity.meshing import discontinuity_patches
+
+    patches = discontinuity_patches(load_preset("cornell"), 250)
+    rays = {}
+
+    def counted(key):
+        def occluded(self, origins, dirs):
+            rays[key] = rays.get(key, 0) + len(origins)
+            return original(self, origins, dirs)
+        return occluded
+
+    original = FormFactors._occluded
+    monkeypatch.setattr(FormFactors, "_occluded", counted("culled"))
+    culled = FormFactors(patches, "raycast").matrix()
+    blockable = formfactors._blockable
+    monkeypatch.setattr(formfactors, "_blockable",
+                        lambda pairs, *args: np.ones(len(pairs), np.int8))
+    monkeypatch.setattr(FormFactors, "_occluded", counted("every"))
+    every = FormFactors(patches, "raycast").matrix()
+    np.testing.assert_allclose(culled, every, rtol=0.0, atol=1e-7 * every.max())
+    assert rays["culled"] < 0.6 * rays["every"]
+    print(f"\nrays {rays['culled']} of {rays['every']}, "
+          f"largest difference {np.abs(culled - every).max():.2e}")
+    # the shortcut is taken: some pairs are wholly blocked, and their factor is 0
+    planes, planar, lo, hi, inward, sides, eps = FormFactors(patches, "raycast")._occluders()
+    i, j = np.nonzero(every > 0.0)
+    code = blockable(np.stack([i, j], axis=1).astype(np.int64), patches.polygons,
+                     patches.surface, planes, planar, lo, hi, inward, sides, eps)
+    assert (code == 2).sum() == 0  # a pair with F > 0 is never wholly blocked
+    i, j = np.nonzero((every == 0.0) & (patches.normals @ patches.normals.T < 0.5))
+    code = blockable(np.stack([i, j], axis=1).astype(np.int64), patches.polygons,
+                     patches.surface, planes, planar, lo, hi, inward, sides, eps)
+    assert (code == 2).sum() > 100

@@ -137,20 +137,24 @@ def reference_noise(images: list[np.ndarray], mask: np.ndarray) -> float:
 
 def error_vs_time(scene, size, reference, mask, counts, meshing: str,
                   budget_s: float | None = None) -> list[dict]:
-    """Rows (patches, seconds, error) of uniform-solver runs at increasing patch counts:
-    ``seconds`` is meshing + ray-cast form factors + Gauss-Seidel (the image is not timed);
-    stops after the first run over ``budget_s`` past the budget (to show the trend)."""
+    """Rows (patches, seconds, cpu_s, error) of runs at increasing patch counts: ``seconds``
+    is the wall time of meshing + ray-cast form factors + the preset's solver (what
+    ``shadelab radiosity`` runs; the image is not timed), ``cpu_s`` the process's CPU time
+    over the same span (the work is single-threaded: what an idle core takes, readable on a
+    loaded machine); stops after the first run over ``budget_s`` past the budget (to show
+    the trend)."""
     from shadelab.radiosity.solution import solve_scene
 
     rows = []
     for count in counts:
-        start = time.perf_counter()
-        solution = solve_scene(scene, count, "raycast", "gauss-seidel", adaptive=False,
+        start, cpu = time.perf_counter(), time.process_time()
+        solution = solve_scene(scene, count, "raycast", None, adaptive=False,
                                meshing=meshing)
-        seconds = time.perf_counter() - start
+        seconds, cpu = time.perf_counter() - start, time.process_time() - cpu
         image = solution.image(size, supersample=SUPERSAMPLE)
         rows.append({"target": int(count), "patches": len(solution.patches),
-                     "seconds": seconds, "error": image_error(image, reference, mask)})
+                     "seconds": seconds, "cpu_s": cpu,
+                     "error": image_error(image, reference, mask)})
         if budget_s is not None and seconds > 1.5 * budget_s:
             break
     return rows
@@ -173,7 +177,7 @@ def error_in_budget(scene, quick: bool) -> dict:
     for meshing in ("uniform", "discontinuity"):
         from shadelab.radiosity.solution import solve_scene
 
-        solve_scene(scene, 20, "raycast", "gauss-seidel", adaptive=False, meshing=meshing)
+        solve_scene(scene, 20, "raycast", None, adaptive=False, meshing=meshing)
         if mask is None:
             mask = emitter_ring_mask(solve_scene(scene, 100, adaptive=False, meshing="uniform"),
                                      size)
@@ -185,7 +189,27 @@ def error_in_budget(scene, quick: bool) -> dict:
     return {"radiosity_error_in_2s": min(errors) if errors else None,
             "best_in_2s": best, "goal": 0.015, "budget_s": BUDGET_S, "size": list(size),
             "supersample": SUPERSAMPLE, "reference": info, "error_vs_time": series,
-            "timed": "meshing + ray-cast form factors + Gauss-Seidel, single process"}
+            "defaults": at_defaults(scene, size, reference, mask),
+            "solver": scene.radiosity.solver,
+            "timed": "meshing + ray-cast form factors + the preset's solver, single process"}
+
+
+def at_defaults(scene, size, reference, mask, repeats: int = 3) -> dict:
+    """``shadelab radiosity cornell`` as a user runs it (the preset's patches, meshing,
+    form factors and solver): median seconds of ``repeats`` solves, and the error."""
+    from shadelab.radiosity.solution import solve_scene
+
+    seconds, cpu, solution = [], [], None
+    for _ in range(repeats):
+        start, cpu_start = time.perf_counter(), time.process_time()
+        solution = solve_scene(scene)
+        seconds.append(time.perf_counter() - start)
+        cpu.append(time.process_time() - cpu_start)
+    image = solution.image(size, supersample=SUPERSAMPLE)
+    return {"patches": len(solution.patches), "meshing": solution.stats["meshing"],
+            "solver": solution.stats["solver"], "seconds": float(np.median(seconds)),
+            "samples_s": seconds, "cpu_s": float(np.median(cpu)),
+            "error": image_error(image, reference, mask)}
 
 
 def time_pathtracer(scene, size, reference, mask, spps, seed: int = 7) -> dict:

@@ -98,6 +98,13 @@ def patch_accel(scene: Scene, patches: PatchSet):
     return build_accel(geometry)
 
 
+def _on_clustered_mesh(patches: PatchSet) -> np.ndarray | None:
+    """(N,) bool: patches of a clustered mesh, when the patch set has any (else None)."""
+    if not (patches.info.get("clustered") and patches.surfaces):
+        return None
+    return np.array([s.kind == "mesh" for s in patches.surfaces], bool)[patches.surface]
+
+
 def direct_radiosity(scene: Scene, patches: PatchSet, shadows: bool = True,
                      accel=None, rho: np.ndarray | None = None) -> tuple[np.ndarray, dict]:
     """(N, 3) E_direct = rho * H per patch and, per light (by label), the power it puts on
@@ -119,10 +126,27 @@ def direct_radiosity(scene: Scene, patches: PatchSet, shadows: bool = True,
             accel = patch_accel(scene, patches)
         eps = scene.raytrace.offset * accel.geometry.diagonal
         occluded = accel.occluded
+    # Shadow rays where meshes are clustered: a clustered mesh's own patches test against
+    # the patches (they lie inside the original surface, which would shadow them); every
+    # other patch (a floor under a scan) against the scene's own triangles, so the scan
+    # casts the shadow the raster and the path tracer show, not its clusters' (coarse, with
+    # gaps between them)
+    on_mesh = _on_clustered_mesh(patches) if shadows else None
+    if on_mesh is not None and not on_mesh.all():
+        from shadelab.raytrace.accel import build_accel, scene_geometry
+
+        original = build_accel(scene_geometry(scene)).occluded
     points = sample_points(patches).reshape(-1, 3)
     normals = np.repeat(patches.normals, SAMPLES, axis=0)
     for index, light in enumerate(lights):
-        h = irradiance(light, points, normals, occluded, eps).reshape(n, SAMPLES).mean(axis=1)
+        if on_mesh is None or on_mesh.all():
+            h = irradiance(light, points, normals, occluded, eps)
+        else:
+            mesh = np.repeat(on_mesh, SAMPLES)
+            h = np.empty(len(points))
+            h[mesh] = irradiance(light, points[mesh], normals[mesh], occluded, eps)
+            h[~mesh] = irradiance(light, points[~mesh], normals[~mesh], original, eps)
+        h = h.reshape(n, SAMPLES).mean(axis=1)
         H = h[:, None] * np.asarray(light.Ip, float)[None, :]
         out += rho * H
         label = light_label(light, index)

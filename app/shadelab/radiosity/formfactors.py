@@ -163,9 +163,14 @@ def _build_rays(pairs, recv, src, src_w, normals, areas, rays, eps):
             x2 = recv[i, k, 2] + eps * normals[i, 2]
             count = 0
             for ell in range(s_count):
-                w, _, _, _ = _wallace(x0, x1, x2, normals[i], src[j, ell, 0], src[j, ell, 1],
-                                      src[j, ell, 2], normals[j], areas[j] * src_w[j, ell])
-                if w > 0.0:
+                # Wallace's weight is > 0 exactly where the sample is in front of both
+                # patches (and has area): two signs, no square root
+                d0 = src[j, ell, 0] - x0
+                d1 = src[j, ell, 1] - x1
+                d2 = src[j, ell, 2] - x2
+                if (d0 * normals[i, 0] + d1 * normals[i, 1] + d2 * normals[i, 2] > 0.0
+                        and d0 * normals[j, 0] + d1 * normals[j, 1] + d2 * normals[j, 2] < 0.0
+                        and src_w[j, ell] > 0.0):
                     front[count] = ell
                     count += 1
             for q in range(rays):
@@ -183,17 +188,107 @@ def _build_rays(pairs, recv, src, src_w, normals, areas, rays, eps):
 
 
 @numba.njit(cache=True)
-def _blockable(pairs, polygons, surface_of, planes, planar, lo, hi, eps):
+def _section(polygons, i, j, d, lo, hi, inward, pad, c_lo, c_hi, crossings):
+    """Where the shaft between patches i and j (the convex hull of their 8 corners) meets a
+    planar surface's plane. ``d`` (8,): the corners' signed distances to the plane. The
+    hull's section by the plane is the convex hull of the points where corner-to-corner
+    segments of opposite sides cross it (and of the corners on it). Returns 0 where that
+    section's box, padded by ``pad``, misses the box [lo, hi] (no ray between i and j can
+    meet the surface), 2 where i and j lie strictly on opposite sides, every crossing is
+    well inside the segments and inside the surface's convex quad ``corners`` by ``pad``
+    (every ray between them meets it), else 1. ``inward`` (4, 4): the quad's edges as
+    unit inward normals n and offsets o (n . x + o >= 0 inside); ``c_lo``, ``c_hi`` (3,)
+    and ``crossings`` (16, 3): scratch space."""
+    c_lo[0] = c_lo[1] = c_lo[2] = np.inf
+    c_hi[0] = c_hi[1] = c_hi[2] = -np.inf
+    whole = ((d[0] > pad and d[1] > pad and d[2] > pad and d[3] > pad
+              and d[4] < -pad and d[5] < -pad and d[6] < -pad and d[7] < -pad)
+             or (d[0] < -pad and d[1] < -pad and d[2] < -pad and d[3] < -pad
+                 and d[4] > pad and d[5] > pad and d[6] > pad and d[7] > pad))
+    count = 0
+    for q in range(8):
+        if d[q] < 0.0:
+            continue
+        pq = i if q < 4 else j
+        kq = q % 4
+        if d[q] == 0.0:
+            for c in range(3):
+                c_lo[c] = min(c_lo[c], polygons[pq, kq, c])
+                c_hi[c] = max(c_hi[c], polygons[pq, kq, c])
+            continue
+        for r in range(8):
+            if d[r] >= 0.0:
+                continue
+            pr = i if r < 4 else j
+            kr = r % 4
+            t = d[q] / (d[q] - d[r])
+            if whole:  # t from i's side: rays start on i and stop 1e-4 short of j
+                ti = t if q < 4 else 1.0 - t
+                if ti < 1e-3 or ti > 1.0 - 1e-3:
+                    whole = False
+            x0 = polygons[pq, kq, 0] + t * (polygons[pr, kr, 0] - polygons[pq, kq, 0])
+            x1 = polygons[pq, kq, 1] + t * (polygons[pr, kr, 1] - polygons[pq, kq, 1])
+            x2 = polygons[pq, kq, 2] + t * (polygons[pr, kr, 2] - polygons[pq, kq, 2])
+            c_lo[0], c_hi[0] = min(c_lo[0], x0), max(c_hi[0], x0)
+            c_lo[1], c_hi[1] = min(c_lo[1], x1), max(c_hi[1], x1)
+            c_lo[2], c_hi[2] = min(c_lo[2], x2), max(c_hi[2], x2)
+            if count < 16:
+                crossings[count, 0], crossings[count, 1], crossings[count, 2] = x0, x1, x2
+            count += 1
+    for c in range(3):
+        if c_hi[c] + pad < lo[c] or c_lo[c] - pad > hi[c]:
+            return 0
+    if not whole or count == 0 or count > 16:
+        return 1
+    for k in range(4):
+        for m in range(count):
+            if (inward[k, 0] * crossings[m, 0] + inward[k, 1] * crossings[m, 1]
+                    + inward[k, 2] * crossings[m, 2] + inward[k, 3]) < pad:
+                return 1
+    return 2
+
+
+@numba.njit(cache=True)
+def _sides(polygons, planes, planar, eps):
+    """(N, S) int8 per patch and planar surface: bit 1 if a corner lies in front of its
+    plane (beyond eps), bit 2 if one lies behind."""
+    out = np.zeros((len(polygons), len(planes)), np.int8)
+    for i in range(len(polygons)):
+        for s in range(len(planes)):
+            if not planar[s]:
+                continue
+            for k in range(4):
+                d = (planes[s, 0] * polygons[i, k, 0] + planes[s, 1] * polygons[i, k, 1]
+                     + planes[s, 2] * polygons[i, k, 2] + planes[s, 3])
+                if d > eps:
+                    out[i, s] |= 1
+                elif d < -eps:
+                    out[i, s] |= 2
+    return out
+
+
+@numba.njit(cache=True)
+def _blockable(pairs, polygons, surface_of, planes, planar, lo, hi, inward, sides, eps):
     """Shaft culling (after Haines & Wallace 1991): can any surface block patch i from j?
 
     A surface can only if the box around both patches meets its box and, when it is
-    planar, the two patches are not both in front of (or both behind) its plane. Patch sets
-    without surfaces (one surface 0 for all) keep every pair.
+    planar, the two patches are not both in front of (or both behind) its plane and the
+    shaft between them crosses that plane inside the surface's box (:func:`_crosses_box`).
+    Culled pairs are those no ray between them can hit, so the matrix is the same with
+    fewer rays (Cornell, 1029 patches: 4.4 M rays -> 3.4 M). Returns per pair 0 (nothing
+    can block: no rays), 1 (cast the rays) or 2 (one planar surface blocks every ray, see
+    :func:`_section`: no rays, visibility 0). Patch sets without surfaces (one surface 0
+    for all) keep every pair.
     """
-    out = np.zeros(len(pairs), np.bool_)
+    out = np.zeros(len(pairs), np.int8)
     count = len(planes)
+    pad = 100.0 * eps  # rays start and end eps off the patches
     blo = np.empty(3)
     bhi = np.empty(3)
+    d = np.empty(8)
+    c_lo = np.empty(3)
+    c_hi = np.empty(3)
+    crossings = np.empty((16, 3))
     for p in range(len(pairs)):
         i, j = pairs[p, 0], pairs[p, 1]
         for c in range(3):
@@ -210,19 +305,103 @@ def _blockable(pairs, polygons, surface_of, planes, planar, lo, hi, eps):
                     or blo[1] > hi[s, 1] or bhi[2] < lo[s, 2] or blo[2] > hi[s, 2]):
                 continue
             if planar[s] and count > 1:
-                above = below = False
-                for q in (i, j):
-                    for k in range(4):
-                        d = (planes[s, 0] * polygons[q, k, 0] + planes[s, 1] * polygons[q, k, 1]
-                             + planes[s, 2] * polygons[q, k, 2] + planes[s, 3])
-                        if d > eps:
-                            above = True
-                        elif d < -eps:
-                            below = True
-                if not (above and below):
+                if (sides[i, s] | sides[j, s]) != 3:
+                    continue  # both patches in front of its plane, or both behind
+                for q in range(8):
+                    patch = i if q < 4 else j
+                    k = q % 4
+                    d[q] = (planes[s, 0] * polygons[patch, k, 0]
+                            + planes[s, 1] * polygons[patch, k, 1]
+                            + planes[s, 2] * polygons[patch, k, 2] + planes[s, 3])
+                code = _section(polygons, i, j, d, lo[s], hi[s], inward[s], pad, c_lo, c_hi,
+                                crossings)
+                if code == 0:
                     continue
-            out[p] = True
-            break
+                if code == 2:
+                    out[p] = 2
+                    break
+            out[p] = 1
+            if not planar[s]:
+                break  # a curved surface: the rays decide
+    return out
+
+
+@numba.njit(cache=True)
+def _seen_pairs(kernel, rows):
+    """(pairs (P, 2) of (patch i, patch j), a (P,) the block row of i) where some receiver
+    point of i sees j (kernel > 0)."""
+    count = 0
+    for a in range(kernel.shape[0]):
+        for j in range(kernel.shape[1]):
+            for k in range(kernel.shape[2]):
+                if kernel[a, j, k] > 0.0:
+                    count += 1
+                    break
+    pairs = np.empty((count, 2), np.int64)
+    block = np.empty(count, np.int64)
+    p = 0
+    for a in range(kernel.shape[0]):
+        for j in range(kernel.shape[1]):
+            for k in range(kernel.shape[2]):
+                if kernel[a, j, k] > 0.0:
+                    pairs[p, 0], pairs[p, 1], block[p] = rows[a], j, a
+                    p += 1
+                    break
+    return pairs, block
+
+
+@numba.njit(cache=True)
+def _hide(kernel, a, pairs, recv, src, src_w, normals, eps):
+    """Pairs with a surface across their whole shaft: visibility 0 at every receiver point
+    that sees a source sample in front of both patches (as its rays would all be blocked;
+    a point that sees none keeps its kernel, as in :func:`_apply_visibility`)."""
+    k_count = recv.shape[1]
+    s_count = src.shape[1]
+    for p in range(len(pairs)):
+        i, j = pairs[p, 0], pairs[p, 1]
+        for k in range(k_count):
+            x0 = recv[i, k, 0] + eps * normals[i, 0]
+            x1 = recv[i, k, 1] + eps * normals[i, 1]
+            x2 = recv[i, k, 2] + eps * normals[i, 2]
+            for ell in range(s_count):
+                d0 = src[j, ell, 0] - x0
+                d1 = src[j, ell, 1] - x1
+                d2 = src[j, ell, 2] - x2
+                if (d0 * normals[i, 0] + d1 * normals[i, 1] + d2 * normals[i, 2] > 0.0
+                        and d0 * normals[j, 0] + d1 * normals[j, 1] + d2 * normals[j, 2] < 0.0
+                        and src_w[j, ell] > 0.0):
+                    kernel[a[p], j, k] = 0.0
+                    break
+
+
+@numba.njit(cache=True)
+def _apply_visibility(kernel, a, j, hit, weights, rays):
+    """kernel[a, j, k] *= seen / total of the Wallace weights of point k's rays (a point
+    whose rays all have weight 0 keeps its kernel: it is a sliver)."""
+    k_count = kernel.shape[2]
+    r = 0
+    for p in range(len(a)):
+        for k in range(k_count):
+            seen = total = 0.0
+            for _ in range(rays):
+                total += weights[r]
+                if not hit[r]:
+                    seen += weights[r]
+                r += 1
+            if total > 0.0:
+                kernel[a[p], j[p], k] *= seen / max(total, 1e-300)
+
+
+@numba.njit(cache=True)
+def _integrate(kernel, weights):
+    """(rows, N): sum_k kernel[a, j, k] * weights[a, k] (the receiver quadrature)."""
+    out = np.zeros((kernel.shape[0], kernel.shape[1]))
+    for a in range(kernel.shape[0]):
+        for j in range(kernel.shape[1]):
+            total = 0.0
+            for k in range(kernel.shape[2]):
+                total += kernel[a, j, k] * weights[a, k]
+            out[a, j] = total
     return out
 
 
@@ -328,33 +507,32 @@ class FormFactors:
         p = self.patches
         kernel = _unoccluded(rows, p.polygons, p.normals, self._recv, self.eps, p.areas, half)
         if self.method == "raycast":
-            kernel = kernel * self._visibility(rows, kernel)
-        return np.einsum("ajk,ak->aj", kernel, self._recv_w[rows])
+            self._visibility(rows, kernel)
+        return _integrate(kernel, self._recv_w[rows])
 
-    def _visibility(self, rows: np.ndarray, kernel: np.ndarray) -> np.ndarray:
-        """Wallace-weighted visible share per receiver point (len(rows), N, K)."""
+    def _visibility(self, rows: np.ndarray, kernel: np.ndarray) -> None:
+        """Multiply the per-point kernels (len(rows), N, K) by their Wallace-weighted visible
+        share, in place (pairs no surface can come between keep 1)."""
         p = self.patches
         if self._src is None:
             self._src, self._src_w = source_samples(p.polygons)
-        a, j = np.nonzero(kernel.max(axis=2) > 0.0)
-        vis = np.ones_like(kernel)
+        pairs, a = _seen_pairs(kernel, rows)
         if len(a) == 0:
-            return vis
-        pairs = np.stack([rows[a], j], axis=1).astype(np.int64)
-        # Shaft culling: rays only where some surface could stand between the two patches
-        blockable = _blockable(pairs, p.polygons, p.surface, *self._occluders())
-        a, j, pairs = a[blockable], j[blockable], pairs[blockable]
+            return
+        # Shaft culling: rays only where some surface could stand between the two patches,
+        # and none where one surface stands across the whole shaft
+        code = _blockable(pairs, p.polygons, p.surface, *self._occluders())
+        hidden = code == 2
+        if hidden.any():
+            _hide(kernel, a[hidden], pairs[hidden], self._recv, self._src, self._src_w,
+                  p.normals, self.eps)
+        a, pairs = a[code == 1], pairs[code == 1]
         if len(a) == 0:
-            return vis
+            return
         origins, dirs, weights = _build_rays(pairs, self._recv, self._src, self._src_w,
                                              p.normals, p.areas, self.rays, self.eps)
         hit = self._occluded(origins, dirs)
-        k_count = self._recv.shape[1]
-        weights = weights.reshape(len(pairs), k_count, self.rays)
-        seen = np.where(hit.reshape(weights.shape), 0.0, weights).sum(axis=2)
-        total = weights.sum(axis=2)
-        vis[a, j] = np.where(total > 0.0, seen / np.maximum(total, 1e-300), 1.0)
-        return vis
+        _apply_visibility(kernel, a, pairs[:, 1], hit, weights, self.rays)
 
     def _occluders(self):
         """Per surface: plane (n, d) if planar, and its bounding box (padded by eps)."""
@@ -365,6 +543,7 @@ class FormFactors:
             planar = np.zeros(count, np.bool_)
             lo = np.full((count, 3), np.inf)
             hi = np.full((count, 3), -np.inf)
+            inward = np.zeros((count, 4, 4))  # quad edges: unit inward normal, offset
             for index in range(count):
                 corners = p.polygons[p.surface == index].reshape(-1, 3)
                 if len(corners) == 0:
@@ -376,7 +555,13 @@ class FormFactors:
                     n = p.normals[p.surface == index][0]
                     planes[index] = (*n, -float(n @ corners[0]))
                     planar[index] = True
-            self._occluder_data = (planes, planar, lo, hi, self.eps)
+                    for k in range(4):
+                        edge = surface.corners[(k + 1) % 4] - surface.corners[k]
+                        w = np.cross(n, edge)
+                        w /= max(float(np.linalg.norm(w)), 1e-300)
+                        inward[index, k] = (*w, -float(w @ surface.corners[k]))
+            sides = _sides(p.polygons, planes, planar, self.eps)
+            self._occluder_data = (planes, planar, lo, hi, inward, sides, self.eps)
         return self._occluder_data
 
     def _occluded(self, origins: np.ndarray, dirs: np.ndarray) -> np.ndarray:

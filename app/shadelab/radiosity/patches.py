@@ -54,6 +54,9 @@ class Surface:
     grid: tuple[int, int] = (1, 1)
     vertices: np.ndarray | None = None
     faces: np.ndarray | None = None
+    original: tuple | None = None  # a clustered mesh's own (vertices, faces, and each
+    #                                vertex's clustered vertex): the display draws these
+
 
     def point(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
         """World points of integer quadtree coordinates (x along u, y along v)."""
@@ -181,16 +184,19 @@ def _count_for(surfaces: list[Surface], h: float) -> int:
     return total
 
 
-def cluster_mesh(vertices: np.ndarray, faces: np.ndarray, target: int
-                 ) -> tuple[np.ndarray, np.ndarray]:
+def cluster_mesh(vertices: np.ndarray, faces: np.ndarray, target: int,
+                 vertex_map: bool = False):
     """At most ``target`` triangles standing for ``faces``: vertex clustering on the finest
     regular grid (bisection on its cell size) that leaves no more; each cell's vertices merge
-    into their mean, collapsed and repeated triangles go. The input when it already fits."""
+    into their mean, collapsed and repeated triangles go. The input when it already fits.
+
+    Returns (vertices, faces); with ``vertex_map`` also (V_in,) the clustered vertex each
+    input vertex merged into (the nearest one where its cell's triangles all collapsed)."""
     vertices = np.asarray(vertices, float)
     faces = np.asarray(faces, np.int64)
     target = max(1, int(target))
     if len(faces) <= target:
-        return vertices, faces
+        return (vertices, faces, np.arange(len(vertices))) if vertex_map else (vertices, faces)
     lo_corner = vertices.min(axis=0)
     extent = max(float(np.ptp(vertices, axis=0).max()), 1e-12)
 
@@ -215,21 +221,33 @@ def cluster_mesh(vertices: np.ndarray, faces: np.ndarray, target: int
             area = np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
             f = f[area > 1e-12 * extent * extent]
         used, f = np.unique(f, return_inverse=True)
-        return merged[used], f.reshape(-1, 3)
+        return merged[used], f.reshape(-1, 3), (used, inverse)
 
     lo = extent / max(math.sqrt(target), 1.0) / 16.0  # fine enough to keep > target
     hi = extent * 1.01  # one cell: no triangle left
     best = clustered(hi)
     for _ in range(CLUSTER_ROUNDS):
         mid = math.sqrt(lo * hi)
-        v, f = clustered(mid)
+        v, f, cells = clustered(mid)
         if len(f) <= target:
-            hi, best = mid, (v, f)
+            hi, best = mid, (v, f, cells)
         else:
             lo = mid
         if hi / lo < 1.01:
             break
-    return best
+    v, f, (used, inverse) = best
+    if not vertex_map:
+        return v, f
+    if len(used) == 0:  # every triangle collapsed: nothing to draw
+        return v, f, np.zeros(len(vertices), np.int64)
+    where = np.searchsorted(used, inverse)
+    found = (where < len(used)) & (used[np.minimum(where, len(used) - 1)] == inverse)
+    out = np.where(found, where, -1)
+    if (~found).any() and len(v):
+        from scipy.spatial import cKDTree
+
+        out[~found] = cKDTree(v).query(vertices[~found])[1]
+    return v, f, np.maximum(out, 0)
 
 
 def _cluster_targets(surfaces: list[Surface], count: int) -> dict[int, int]:
@@ -258,9 +276,7 @@ def uniform_patches(scene: Scene, count: int) -> PatchSet:
     surfaces = scene_surfaces(scene)
     if not surfaces:
         raise ShadeLabError("objects: the scene has no surfaces to mesh into patches")
-    mesh_faces = sum(len(s.faces) for s in surfaces if s.kind == "mesh")
-    quads = sum(1 for s in surfaces if s.kind == "quad")
-    if mesh_faces and mesh_faces + quads > count:
+    if needs_clustering(surfaces, count):
         return _clustered_patches(scene, surfaces, count)
     total = sum(_surface_area(s) for s in surfaces)
     # Find the patch size h whose meshing comes closest to the target count (bisection on log h)
@@ -290,39 +306,62 @@ def uniform_patches(scene: Scene, count: int) -> PatchSet:
     return assemble(scene, surfaces, leaves)
 
 
+def needs_clustering(surfaces: list[Surface], count: int) -> bool:
+    """Would one patch per mesh triangle (and one cell per quad) exceed ``count``?"""
+    mesh_faces = sum(len(s.faces) for s in surfaces if s.kind == "mesh")
+    quads = sum(1 for s in surfaces if s.kind == "quad")
+    return bool(mesh_faces) and mesh_faces + quads > count
+
+
+def cluster_surfaces(surfaces: list[Surface], count: int) -> int:
+    """Cluster every mesh surface (in place) to its share of ``count``
+    (:func:`_cluster_targets`); returns the patches left to the quads."""
+    targets = _cluster_targets(surfaces, count)
+    for index, target in targets.items():
+        s = surfaces[index]
+        vertices, faces = s.vertices, s.faces
+        s.vertices, s.faces, to_cluster = cluster_mesh(vertices, faces, target, vertex_map=True)
+        if len(s.faces) < len(faces):
+            s.original = (vertices, faces, to_cluster)
+    return count - sum(len(surfaces[i].faces) for i in targets)
+
+
+def quad_leaves(surfaces: list[Surface], rest: int) -> list[tuple]:
+    """The regular grid of the coarsest cell size h with at most ``rest`` quad cells (at
+    least one each): sets each quad surface's ``grid``, returns its leaves."""
+    quad_area = sum(_surface_area(s) for s in surfaces if s.kind == "quad")
+    leaves: list[tuple] = []
+    if quad_area <= 0.0:
+        return leaves
+    lo = math.sqrt(quad_area / max(rest, 1)) / 8.0
+    hi = max(math.sqrt(quad_area / max(rest, 1)) * 4.0,
+             max(float(np.ptp(s.corners, axis=0).max()) for s in surfaces
+                 if s.kind == "quad") * 2.0)
+    for _ in range(40):
+        mid = math.sqrt(lo * hi)
+        if _quad_count(surfaces, mid) > rest:
+            lo = mid
+        else:
+            hi = mid
+    for index, s in enumerate(surfaces):
+        if s.kind != "quad":
+            continue
+        s.grid = _quad_grid(s.corners, hi)
+        for i in range(s.grid[0]):
+            for j in range(s.grid[1]):
+                leaves.append((index, i * FINE, j * FINE, (i + 1) * FINE, (j + 1) * FINE))
+    return leaves
+
+
 def _clustered_patches(scene: Scene, surfaces: list[Surface], count: int) -> PatchSet:
     """Meshes clustered to their share of ``count`` (:func:`_cluster_targets`), quads on the
     regular grid of the coarsest size h that fits the rest (at least one cell each)."""
     import time
 
     start = time.perf_counter()
-    targets = _cluster_targets(surfaces, count)
-    triangles_in = sum(len(surfaces[i].faces) for i in targets)
-    for index, target in targets.items():
-        s = surfaces[index]
-        s.vertices, s.faces = cluster_mesh(s.vertices, s.faces, target)
-    rest = count - sum(len(surfaces[i].faces) for i in targets)
-    quad_area = sum(_surface_area(s) for s in surfaces if s.kind == "quad")
-    leaves = []
-    if quad_area > 0.0:
-        lo = math.sqrt(quad_area / max(rest, 1)) / 8.0
-        hi = max(math.sqrt(quad_area / max(rest, 1)) * 4.0,
-                 max(float(np.ptp(s.corners, axis=0).max()) for s in surfaces
-                     if s.kind == "quad") * 2.0)
-        for _ in range(40):
-            mid = math.sqrt(lo * hi)
-            if _quad_count(surfaces, mid) > rest:
-                lo = mid
-            else:
-                hi = mid
-        for index, s in enumerate(surfaces):
-            if s.kind != "quad":
-                continue
-            s.grid = _quad_grid(s.corners, hi)
-            for i in range(s.grid[0]):
-                for j in range(s.grid[1]):
-                    leaves.append((index, i * FINE, j * FINE, (i + 1) * FINE, (j + 1) * FINE))
-    patches = assemble(scene, surfaces, leaves)
+    triangles_in = sum(len(s.faces) for s in surfaces if s.kind == "mesh")
+    rest = cluster_surfaces(surfaces, count)
+    patches = assemble(scene, surfaces, quad_leaves(surfaces, rest))
     patches.info.update(clustered=True, clustering_s=time.perf_counter() - start,
                         mesh_triangles=triangles_in)
     return patches

@@ -156,17 +156,53 @@ def solve_gauss_seidel(F: np.ndarray, rho: np.ndarray, E: np.ndarray, iterations
 
 
 # ---------------------------------------------------------------------- shooting
+@numba.njit(cache=True)
+def _shoot(f, areas, rho, B, unshot, i):
+    """One shot from patch i through its row f = F_i. (in place on B and unshot): every j
+    gains rho_j dB_i F_ij A_i / A_j. Returns the next shooter (the largest unshot energy,
+    first on ties) and the unshot power per channel, sum_j dB_j A_j."""
+    n = len(areas)
+    s0, s1, s2 = unshot[i, 0], unshot[i, 1], unshot[i, 2]
+    ai = areas[i]
+    for j in range(n):
+        w = f[j] * ai / areas[j]
+        if w != 0.0:
+            g0, g1, g2 = rho[j, 0] * s0 * w, rho[j, 1] * s1 * w, rho[j, 2] * s2 * w
+            B[j, 0] += g0
+            B[j, 1] += g1
+            B[j, 2] += g2
+            unshot[j, 0] += g0
+            unshot[j, 1] += g1
+            unshot[j, 2] += g2
+    unshot[i, 0] = unshot[i, 1] = unshot[i, 2] = 0.0
+    power = np.zeros(3)
+    best, best_energy = 0, -1.0
+    for j in range(n):
+        e0, e1, e2 = unshot[j, 0] * areas[j], unshot[j, 1] * areas[j], unshot[j, 2] * areas[j]
+        power[0] += e0
+        power[1] += e1
+        power[2] += e2
+        energy = e0 + e1 + e2
+        if energy > best_energy:
+            best, best_energy = j, energy
+    return best, power
+
+
 def solve_progressive(row: Callable[[int], np.ndarray], areas: np.ndarray, rho: np.ndarray,
                       E: np.ndarray, max_shots: int = 100000,
                       tolerance: float = 1e-4) -> Iterator[Step]:
     """Progressive refinement: shoot the largest unshot energy, one row of F per shot.
 
-    ``row(i)`` returns F_i. (computed on demand). A shot from i adds to every j
-    dB_j = rho_j dB_i F_ji = rho_j dB_i F_ij A_i / A_j (reciprocity), so the hemicube or the
-    rays are cast from the shooter only.
+    ``row(i)`` returns F_i. (the solution's drivers hand it rows of the reciprocal matrix
+    that the gathering solvers read, :func:`shadelab.radiosity.solution.solver_steps`). A
+    shot from i adds to every j dB_j = rho_j dB_i F_ji = rho_j dB_i F_ij A_i / A_j
+    (reciprocity), so the hemicube or the rays are cast from the shooter only. Each shot is
+    one compiled pass over the patches (:func:`_shoot`).
     """
     start = time.perf_counter()
     B, unshot = E.astype(np.float64).copy(), E.astype(np.float64).copy()
+    areas = np.ascontiguousarray(areas, np.float64)
+    rho = np.ascontiguousarray(rho, np.float64)
     total_area = float(areas.sum())
     # Ambient term (Cohen et al. 1988): area-weighted reflectance and its interreflection sum
     rho_avg = (rho * areas[:, None]).sum(axis=0) / total_area
@@ -174,17 +210,12 @@ def solve_progressive(row: Callable[[int], np.ndarray], areas: np.ndarray, rho: 
     initial = float((E * areas[:, None]).sum())
     if initial <= 0.0:
         raise ShadeLabError("radiosity: nothing emits light (no material with emission > 0)")
+    i = int(np.argmax((unshot * areas[:, None]).sum(axis=1)))
     for k in range(1, max_shots + 1):
-        energy = (unshot * areas[:, None]).sum(axis=1)
-        i = int(np.argmax(energy))
-        shot = unshot[i].copy()
-        f = row(i)
-        gain = rho * shot[None, :] * (f * areas[i] / areas)[:, None]
-        B += gain
-        unshot += gain
-        unshot[i] = 0.0
-        left = float((unshot * areas[:, None]).sum()) / initial
-        ambient = interreflection * (unshot * areas[:, None]).sum(axis=0) / total_area
+        f = np.ascontiguousarray(row(i), np.float64)
+        i, power = _shoot(f, areas, rho, B, unshot, i)
+        left = float(power.sum()) / initial
+        ambient = interreflection * power / total_area
         yield Step(B, k, float("nan"), left, time.perf_counter() - start, ambient)
         if left < tolerance:
             break
