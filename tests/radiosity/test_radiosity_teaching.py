@@ -100,8 +100,8 @@ def _all_rows(progresses) -> dict:
 
 
 def test_the_rows_sent_are_the_rows_the_solver_shot_with():
-    """Every shooter's row arrives in ``ff_rows`` (sent once), equal to F's row as the
-    form-factor engine computes it; a second job on the same geometry sends every known row
+    """Every shooter's row arrives in ``ff_rows`` (sent once), equal to the row of the
+    reciprocal matrix the form-factor engine computes (the one every solver reads); a second job on the same geometry sends every known row
     in its first Progress (the window may have missed none)."""
     scene = _cornell(tolerance=0.05)
     pipeline._RADIOSITY_CACHE.clear()
@@ -110,9 +110,9 @@ def test_the_rows_sent_are_the_rows_the_solver_shot_with():
     shooters = {p.stats["shooter_index"] for p in seen if "shooter_index" in p.stats}
     assert len(shooters) > 5 and shooters <= set(rows)
     patches = uniform_patches(scene, PATCHES)
-    fresh = FormFactors(patches, "raycast")
+    matrix = FormFactors(patches, "raycast").matrix()
     for i in sorted(shooters)[:8]:
-        np.testing.assert_allclose(rows[i], fresh.row(i), rtol=1e-12, atol=1e-15)
+        np.testing.assert_allclose(rows[i], matrix[i], rtol=1e-12, atol=1e-15)
     assert seen[-1].stats["form_factors"] == "raycast"
     again = list(pipeline.pipeline_radiosity(scene, None, step_shots=1))
     assert again[0].stats["form_factors_reused"]
