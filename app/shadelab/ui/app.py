@@ -25,6 +25,7 @@ from shadelab.lab.recorder import FrameRecorder
 from shadelab.lab.state import (
     AppState,
 )
+from shadelab.shading.codes import terms_mask
 from shadelab.ui import (
     compare_view,
     equation_panel,
@@ -281,7 +282,7 @@ class Viewer:
         return (id(s.scene), s.scene_version, s.scene.version, size, v.compare, v.diff_enabled,
                 v.diff_pair, v.diff_scale, v.show_wireframe, v.show_normals, v.normal_length,
                 s.probe.version, s.offline.overlay_version, s.offline.show_radiosity, v.tonemap,
-                v.show_clipping, presenter.line_px(s), v.antialias, v.msaa)
+                v.show_clipping, presenter.line_px(s), v.antialias, v.msaa, v.terms_off)
 
     def unchanged(self, size: tuple[int, int]) -> bool:
         """True when the last image is still right (idle frames only redraw the GUI)."""
@@ -310,7 +311,7 @@ class Viewer:
             vp.draw_colored_triangles(pane, scene, state.offline.radiosity_soup)
         else:
             pane = vp.draw_scene("main", scene, size, scene.render.shading, scene.render.specular,
-                                 self.samples())
+                                 self.samples(), terms_mask(state.view.terms_off))
         # --- PASS 3: the probe reads the GPU value before any overlay is drawn
         if state.probe.requested:
             update_probe(state, vp, size, display_size, self.samples())
