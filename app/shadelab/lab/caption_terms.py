@@ -75,8 +75,13 @@ class Run:
     width: float
 
 
+CLAUSE_BREAK = "  "   # two spaces or more part a caption's clauses ("...,   R = 2 N (N . L)")
+CLAUSE = "<clause>"   # the mark a clause's start gets among the tokens
+
+
 def _tokens(text: str) -> list[tuple[str, str | None]]:
-    """Wrap units: a term whole, plain text cut after each space; '\\n' alone."""
+    """Wrap units: a term whole, plain text cut after each space; '\\n' alone; the start of a
+    clause marked by an empty CLAUSE token (the layout keeps a short clause on one line)."""
     out: list[tuple[str, str | None]] = []
     for piece, term in segments(text):
         if term:
@@ -85,9 +90,23 @@ def _tokens(text: str) -> list[tuple[str, str | None]]:
         for part in re.split(r"(\n)", piece):
             if part == "\n":
                 out.append(("\n", None))
-            elif part:
-                out += [(w, None) for w in re.findall(r"\S*\s*|\s+", part) if w]
+                continue
+            for w in re.findall(r"\S*\s*|\s+", part):
+                if w:
+                    out.append((w, None))
+                    if w.endswith(CLAUSE_BREAK):
+                        out.append(("", CLAUSE))
     return out
+
+
+def _clause_width(tokens, start: int, measure) -> float:
+    """Width of the clause that starts at ``tokens[start]`` (to the next clause or line)."""
+    total = 0.0
+    for token, term in tokens[start:]:
+        if token == "\n" or term == CLAUSE:
+            break
+        total += measure(token)
+    return total
 
 
 def layout(text: str, width: float, measure) -> list[Run]:
@@ -95,9 +114,15 @@ def layout(text: str, width: float, measure) -> list[Run]:
     a unit wider than a line gets one to itself); ``measure(text)`` is its width."""
     runs: list[Run] = []
     line, x = 0, 0.0
-    for token, term in _tokens(text):
+    tokens = _tokens(text)
+    for k, (token, term) in enumerate(tokens):
         if token == "\n":
             line, x = line + 1, 0.0
+            continue
+        if term == CLAUSE:      # a clause that fits a line but not this one: a new line
+            clause = _clause_width(tokens, k + 1, measure)
+            if x > 0.0 and x + clause > width and clause <= width:
+                line, x = line + 1, 0.0
             continue
         w = measure(token)
         if x > 0.0 and x + measure(token.rstrip()) > width:

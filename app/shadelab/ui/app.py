@@ -42,6 +42,7 @@ from shadelab.ui import (
     radiosity_view,
     ray_tree_panel,
     scene_panel,
+    stage,
 )
 from shadelab.ui.exercise_panel import draw_exercise_panel
 from shadelab.ui.followups import FollowUps, ViewerOptions, write_window_screenshot
@@ -102,10 +103,11 @@ SHORTCUTS = (
     (K.d, "D", "difference heat map (compare)", _toggle("diff_enabled")),
     (K.r, "R", "reset view", AppState.reset_view),
     (K.s, "S", "screenshot of the viewport", scene_panel.screenshot),
-    (K.f, "F", "presenter mode (large fonts)", _toggle("presenter")),
+    (K.f, "F", "presenter mode (large fonts, the stage)", presenter.toggle_presenter),
     (K.h, "H", "this help", _toggle("show_help")),
     (K.f1, "F1", "this help", _toggle("show_help")),
-    (K.tab, "Tab", "viewport only (hide every panel)", presenter.toggle_panels),
+    (K.tab, "Tab", "the stage (viewport and step controls) / every panel",
+     presenter.toggle_panels),
     (K.f11, "F11", "fullscreen", presenter.toggle_fullscreen),
     (K.page_down, "PgDn", "next lesson step", lesson.next_step),
     (K.page_up, "PgUp", "previous lesson step", lesson.previous_step),
@@ -215,15 +217,17 @@ class Viewer:
         state = self.state
         origin = imgui.get_cursor_screen_pos()
         avail = imgui.get_content_region_avail()
-        # the caption gets its own band under the image: it never hides the scene
+        # the caption gets its own band under the image: it never hides the scene; on stage
+        # the step's controls get a strip under the caption
         band = presenter.caption_band(state, avail.x)
-        size = (max(int(avail.x), 16), max(int(avail.y - band) - 4, 16))
+        strip = stage.strip_height(state)
+        size = (max(int(avail.x), 16), max(int(avail.y - band - strip) - 4, 16))
         if size != state.view.viewport_size and state.probe.pixel is not None:
             state.probe.requested = True  # the same pixel shows another point now
         state.view.viewport_size = size
         if state.walk.lesson is not None:   # the next step's viewport (its prefetch's size)
             state.walk.next_size = (size[0], max(int(avail.y - presenter.next_step_band(
-                state, avail.x)) - 4, 16))
+                state, avail.x) - strip) - 4, 16))
         if state.view.compare:
             compare_view.draw_compare(self, size)
         else:
@@ -232,6 +236,8 @@ class Viewer:
         # rect can hide them
         presenter.draw_viewport_extras(state, origin, size, self.recorder.redrawn, band)
         presenter.draw_lesson_buttons(state, origin, size, band)
+        stage.draw_strip(state, imgui.ImVec2(origin.x, origin.y + avail.y - strip), avail.x,
+                         strip)
         if not state.view.compare:
             gizmos.draw(state, origin, size)
         self.recorder.viewport_shown = True
@@ -553,6 +559,8 @@ def run_viewer(state: AppState, options: ViewerOptions) -> int:
 def _run(viewer: Viewer, state: AppState, options: ViewerOptions) -> int:
     if options.test_function is None:
         state.view.pipeline = options.pipeline or state.view.pipeline
+        if state.view.presenter:   # --presenter: the stage, Tab brings the panels
+            state.view.hide_panels = True
         if state.view.pipeline in pipelines.OFFLINE:
             pipelines.warm(state)  # an offline view at start: its process spawns at once
         else:  # else once the first frame is up: on 2 cores its imports delay that frame
