@@ -96,3 +96,13 @@ def test_switching_a_term_off_changes_the_probed_total_by_that_term():
     f_att = result.terms.lights[0].f_att
     assert term_value_text(result, "attenuation") == f"{f_att:.2f}"
     assert term_value_text(result, "shadow") == "1.00"
+
+
+def test_a_screenshots_legend_names_the_terms_switched_off():
+    from shadelab.lab.legend import legend_lines
+
+    state = AppState.from_scene(load_preset("lecture"), "lecture")
+    assert "terms off" not in legend_lines(state)[0]
+    toggle_term(state, "specular")
+    toggle_term(state, "ambient")
+    assert legend_lines(state)[0].endswith(", terms off: ambient, specular")
