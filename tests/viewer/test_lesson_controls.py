@@ -38,10 +38,12 @@ def test_a_path_resolves_to_its_field_and_widget():
     assert spec.args == (("phong", "blinn"),)
     c2 = resolve(scene, "lights.0.c2")
     assert c2.cls is Light and c2.owner is scene.lights[0] and c2.args[0] == 0.0
+    assert c2.label == "key c2" and n.label == "plastic n"     # the light by its name
     assert resolve(scene, "render.show_volumes").widget == "checkbox"
     assert resolve(scene, "Ia").widget == "color"
-    assert [control_label(p) for p in ("materials.plastic.n", "lights.0.c2", "render.specular")] \
-        == ["plastic n", "light 0 c2", "specular"]
+    assert [control_label(p) for p in ("materials.plastic.n", "lights.0.c2", "render.specular",
+                                       "render.show_volumes")] \
+        == ["plastic n", "light 0 c2", "specular", "show volumes"]
 
 
 @pytest.mark.parametrize("controls, message", [

@@ -57,13 +57,14 @@ def _spec_of(owner: Any, name: str) -> tuple | None:
 
 def control_label(path: str) -> str:
     """``materials.plastic.n`` -> ``plastic n``; ``lights.0.c2`` -> ``light 0 c2``;
-    ``render.specular`` -> ``specular``; ``Ia`` -> ``Ia``."""
+    ``render.specular`` -> ``specular``; ``render.show_volumes`` -> ``show volumes``."""
     parts = path.split(".")
+    field = parts[-1].replace("_", " ")
     if len(parts) == 3 and parts[0] == "materials":
-        return f"{parts[1]} {parts[2]}"
+        return f"{parts[1]} {field}"
     if len(parts) == 3 and parts[0] == "lights":
-        return f"light {parts[1]} {parts[2]}"
-    return parts[-1]
+        return f"light {parts[1]} {field}"
+    return field
 
 
 def resolve(scene, path: str) -> Control:
@@ -102,7 +103,10 @@ def resolve(scene, path: str) -> Control:
     if kind not in WIDGETS or (kind == "str" and not args[0]):
         raise ShadeLabError(f"control '{path}': a '{kind}' field has no control (expected a "
                             "number, a switch, a choice or a color)")
-    return Control(path.strip(), node, name, kind, tuple(args), control_label(path.strip()))
+    label = control_label(path.strip())
+    if parts[0] == "lights" and len(parts) == 3 and getattr(node, "name", ""):
+        label = f"{node.name} {name.replace('_', ' ')}"   # its own name: "red Ip", "key c2"
+    return Control(path.strip(), node, name, kind, tuple(args), label)
 
 
 def check_controls(scene, paths) -> list[Control]:
