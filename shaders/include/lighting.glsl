@@ -160,14 +160,15 @@ vec3 shade_light(int i, vec3 position, vec3 n, vec3 to_eye, vec3 od) {
 #else
     float s = LIGHT_S(i);
 #endif
-    if (TERM_OFF(TERM_SHADOW)) s = 1.0;
-    vec3 scale = s * f_att * spot * LIGHT_IP(i);
-    float diffuse = TERM_OFF(TERM_DIFFUSE) ? 0.0 : lambert(n, to_light);
+    if (TERM_OFF(TERM_SHADOW)) s = 1.0;          // the terms switched off (u_terms_off)
     if (TERM_OFF(TERM_SPECULAR)) specular = 0.0;
+    vec3 scale = s * f_att * spot * LIGHT_IP(i);
 #ifdef PREMULTIPLIED
+    float diffuse = TERM_OFF(TERM_DIFFUSE) ? 0.0 : lambert(n, to_light);
     return scale * (u_light_diffuse[i] * diffuse + u_light_specular[i] * specular);
 #else
-    return scale * (u_kd * od * diffuse + u_ks * u_Os * specular);
+    if (TERM_OFF(TERM_DIFFUSE)) od = vec3(0.0);
+    return scale * (u_kd * od * lambert(n, to_light) + u_ks * u_Os * specular);
 #endif
 }
 
@@ -178,8 +179,8 @@ vec3 shade(vec3 position, vec3 n, vec3 eye, vec3 od) {
 #ifdef PREMULTIPLIED  // (TERM_AMBIENT folded into u_ambient by the renderer)
     vec3 color = u_ambient;
 #else
-    vec3 color = u_ambient_on * (u_emission + (TERM_OFF(TERM_AMBIENT) ? vec3(0.0)
-                                               : u_Ia * u_ka * od));
+    vec3 color = u_ambient_on * (u_emission + u_Ia * u_ka * od);
+    if (TERM_OFF(TERM_AMBIENT)) color = u_ambient_on * u_emission;
 #endif
     for (int i = 0; i < LIGHT_COUNT; ++i)
         color += shade_light(i, position, n, to_eye, od);
