@@ -106,3 +106,17 @@ def test_a_screenshots_legend_names_the_terms_switched_off():
     toggle_term(state, "specular")
     toggle_term(state, "ambient")
     assert legend_lines(state)[0].endswith(", terms off: ambient, specular")
+
+
+def test_the_terms_are_buttons_only_over_a_raster_image():
+    from shadelab.lab.caption_terms import terms_switchable
+    from shadelab.lab.pipeline_view import set_pipeline
+
+    state = AppState.from_scene(load_preset("lecture"), "lecture")
+    assert terms_switchable(state)
+    set_pipeline(state, "raytrace")           # the ray tracer draws the whole equation
+    assert not terms_switchable(state)
+    set_pipeline(state, "gouraud")
+    assert terms_switchable(state)
+    state.offline.show_radiosity = True       # the solved radiosity meshes, not the raster
+    assert not terms_switchable(state)

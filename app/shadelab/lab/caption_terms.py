@@ -150,6 +150,14 @@ def lines_with_terms(runs: list[Run]) -> set[int]:
 # ---------------------------------------------------------------- switching and reading
 
 
+def terms_switchable(state) -> bool:
+    """The viewport shows a raster image, where the switches act (the offline pipelines and a
+    shown radiosity solution draw the whole equation: their caption's terms are not buttons)."""
+    from shadelab.lab.pipeline_view import RASTER, current
+
+    return current(state) in RASTER and not state.offline.show_radiosity
+
+
 def toggle_term(state, term: str) -> bool:
     """Switch ``term`` off (or on again) in the viewport's image and the probe; True: now on."""
     if term not in TERMS:

@@ -342,7 +342,12 @@ def _live_term(draw, font, state: AppState | None, run, k: int, x: float, y: flo
                font_px: float) -> None:
     """One term of the caption: struck through when off, its probed value under it, and
     (with ``state``) a button over it that switches it."""
-    from shadelab.lab.caption_terms import TERM_COLORS, term_value_text, toggle_term
+    from shadelab.lab.caption_terms import (
+        TERM_COLORS,
+        term_value_text,
+        terms_switchable,
+        toggle_term,
+    )
 
     color = _term_color(state, run.term)
     off = state is not None and run.term in state.view.terms_off
@@ -356,7 +361,7 @@ def _live_term(draw, font, state: AppState | None, run, k: int, x: float, y: flo
     if value:
         draw.add_text(font, value_px, imgui.ImVec2(x, y + font_px + 1.0),
                       _u32(TERM_COLORS[run.term]) if not off else TERM_OFF_COLOR, value)
-    if state is None:
+    if state is None or not terms_switchable(state):
         return
     rect = (x, y, x + run.width, y + font_px + value_px)
     imgui.set_cursor_screen_pos(imgui.ImVec2(x, y))
