@@ -4,12 +4,14 @@
 // colors are linear RGB.
 //
 //   I = Le + Ia ka Od + sum_i S_i f_att,i Ip,i [kd Od (N.L_i) + ks Os (R_i.V)^n]
+//   with any of ambient, diffuse, specular (0), f_att and S_i (1) switched off (u_terms_off)
 //   f_att = 1 | 1/d^2 | min(1/(c1 + c2 d + c3 d^2), 1);   R = 2N(N.L) - L;   H = (L+V)/|L+V|
 
 // Generated ahead of this text by the program loader (shadelab/gl/programs.py) from the Python
 // table (shadelab/shading/codes.py, shadelab/constants.py): MAX_LIGHTS, SHADING_EPS, the light
 // kinds LIGHT_POINT | LIGHT_DIRECTIONAL | LIGHT_SPOT, the attenuation modes ATTENUATION_NONE |
-// ATTENUATION_INVERSE_SQUARE | ATTENUATION_LECTURE and SPECULAR_PHONG | SPECULAR_BLINN.
+// ATTENUATION_INVERSE_SQUARE | ATTENUATION_LECTURE, SPECULAR_PHONG | SPECULAR_BLINN and the
+// term bits TERM_AMBIENT | TERM_DIFFUSE | TERM_SPECULAR | TERM_ATTENUATION | TERM_SHADOW.
 //
 // The renderer compiles one variant per light configuration: NUM_LIGHTS, LIGHT_KINDS and
 // LIGHT_ATTENUATIONS (2 bits per light, light i at bits 2i..2i+1, as uint literals) and
@@ -55,6 +57,10 @@ uniform vec2 u_light_spot[MAX_LIGHTS];           // cos(cone half-angle), fallof
 uniform float u_light_S[MAX_LIGHTS];             // shadow factor S_i: 1 lit, 0 blocked
 uniform float u_terminator;                      // shadow-volume lit pass: 1 fades S_i by the
                                                  // point's threshold t; 0: off (exact equation)
+
+uniform int u_terms_off;                         // TERM_* bits of the terms switched off
+                                                 // (0, the default: the whole equation)
+#define TERM_OFF(t) ((u_terms_off & (t)) != 0)
 
 uniform vec3 u_Ia;                               // ambient intensity
 uniform float u_ambient_on;                      // 1: add Le + Ia ka Od (first pass only)
@@ -141,7 +147,8 @@ vec3 shade_light(int i, vec3 position, vec3 n, vec3 to_eye, vec3 od) {
     vec3 to_point = distance > SHADING_EPS ? delta / distance : vec3(0.0);
     bool directional = kind == LIGHT_DIRECTIONAL;
     vec3 to_light = directional ? -u_light_direction[i] : to_point;
-    float f_att = directional ? 1.0 : attenuation(distance, LIGHT_ATTENUATION(i), u_light_c[i]);
+    float f_att = directional || TERM_OFF(TERM_ATTENUATION) ? 1.0
+                : attenuation(distance, LIGHT_ATTENUATION(i), u_light_c[i]);
     float spot = 1.0;
     if (kind == LIGHT_SPOT)
         spot = spot_factor(to_light, u_light_direction[i], u_light_spot[i].x, u_light_spot[i].y);
@@ -153,10 +160,14 @@ vec3 shade_light(int i, vec3 position, vec3 n, vec3 to_eye, vec3 od) {
 #else
     float s = LIGHT_S(i);
 #endif
+    if (TERM_OFF(TERM_SHADOW)) s = 1.0;          // the terms switched off (u_terms_off)
+    if (TERM_OFF(TERM_SPECULAR)) specular = 0.0;
     vec3 scale = s * f_att * spot * LIGHT_IP(i);
 #ifdef PREMULTIPLIED
-    return scale * (u_light_diffuse[i] * lambert(n, to_light) + u_light_specular[i] * specular);
+    float diffuse = TERM_OFF(TERM_DIFFUSE) ? 0.0 : lambert(n, to_light);
+    return scale * (u_light_diffuse[i] * diffuse + u_light_specular[i] * specular);
 #else
+    if (TERM_OFF(TERM_DIFFUSE)) od = vec3(0.0);
     return scale * (u_kd * od * lambert(n, to_light) + u_ks * u_Os * specular);
 #endif
 }
@@ -165,10 +176,11 @@ vec3 shade(vec3 position, vec3 n, vec3 eye, vec3 od) {
     vec3 to_eye = eye - position;
     float len = length(to_eye);
     to_eye = len > SHADING_EPS ? to_eye / len : vec3(0.0);
-#ifdef PREMULTIPLIED
+#ifdef PREMULTIPLIED  // (TERM_AMBIENT folded into u_ambient by the renderer)
     vec3 color = u_ambient;
 #else
     vec3 color = u_ambient_on * (u_emission + u_Ia * u_ka * od);
+    if (TERM_OFF(TERM_AMBIENT)) color = u_ambient_on * u_emission;
 #endif
     for (int i = 0; i < LIGHT_COUNT; ++i)
         color += shade_light(i, position, n, to_eye, od);

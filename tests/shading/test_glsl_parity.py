@@ -137,3 +137,54 @@ def test_mixed_light_kinds_in_one_program(harness, np_rng, specular):
     ref = shade(points.astype("f4").astype(np.float64), normals.astype("f4"), eye, material,
                 lights, np.full(3, 0.1), specular, od=od.astype("f4"))
     np.testing.assert_allclose(gpu, ref, rtol=1e-4, atol=1e-5)
+
+
+TERM_CASES = ["ambient", "diffuse", "specular", "attenuation", "shadow"]
+
+
+@pytest.mark.parametrize("term", TERM_CASES + ["diffuse+specular"])
+@pytest.mark.parametrize("specular", ["phong", "blinn"])
+def test_a_term_switched_off_matches_numpy(harness, np_rng, term, specular):
+    """lighting.glsl's u_terms_off bits leave out what shade_terms(off=...) leaves out: each
+    term alone (and two at once), with S_i given per light and lecture attenuation, so every
+    switch has something to switch (issue 22: a click on the caption's term)."""
+    from shadelab.shading.codes import terms_mask
+
+    off = tuple(term.split("+"))
+    points = np_rng.uniform(-1, 1, (N_POINTS, 3))
+    normals = normalize(np_rng.normal(size=(N_POINTS, 3)))
+    od = np_rng.uniform(0, 1, (N_POINTS, 3))
+    eye = np.array([0.3, 2.5, 4.0])
+    material = Material(ka=0.4, kd=0.6, ks=0.5, n=12.0, Os=(0.9, 0.8, 0.7))
+    lights = [_random_light(np_rng, "point", "lecture") for _ in range(3)]
+    for light in lights:
+        light.c1, light.c2, light.c3 = 1.0, 0.3, 0.2    # f_att well below 1 at these distances
+    shadow = [0.0, 1.0, 0.5]
+    ctx, program, target = harness(lights, specular)
+    set_uniform(program, "u_terms_off", terms_mask(off))
+    try:
+        data = np.concatenate([points, normals, od], axis=1).astype("f4")
+        vbo = ctx.buffer(data.tobytes())
+        vao = ctx.vertex_array(program, [(vbo, "3f 3f 3f", "in_position", "in_normal", "in_od")])
+        set_uniform(program, "u_count", N_POINTS)
+        set_uniform(program, "u_eye", tuple(eye))
+        set_uniform(program, "u_Ia", (0.3, 0.25, 0.2))
+        set_uniform(program, "u_ambient_on", 1.0)
+        set_uniform(program, "u_specular_model", 1 if specular == "blinn" else 0)
+        Renderer.set_material_uniforms(program, material)
+        write_light_uniforms(program, lights, shadow)
+        target.use()
+        target.clear()
+        ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND)
+        vao.render(moderngl.POINTS)
+        gpu = np.frombuffer(target.read(components=4, dtype="f4"), dtype="f4").reshape(-1, 4)
+        vao.release()
+        vbo.release()
+    finally:
+        set_uniform(program, "u_terms_off", 0)   # the cached program serves other tests
+    p, n, o = points.astype("f4").astype(np.float64), normals.astype("f4"), od.astype("f4")
+    s = [np.full(N_POINTS, v) for v in shadow]
+    ref = shade(p, n, eye, material, lights, (0.3, 0.25, 0.2), specular, s, od=o, off=off)
+    whole = shade(p, n, eye, material, lights, (0.3, 0.25, 0.2), specular, s, od=o)
+    np.testing.assert_allclose(gpu[:, :3], ref, rtol=1e-4, atol=1e-5)
+    assert np.abs(whole - ref).max() > 0.02   # the switch changed the image

@@ -122,13 +122,15 @@ class WorkerProcess:
         self.tasks.put((0, warm_up, None, None))
 
     def kill(self) -> None:
-        if self.process is not None and self.process.is_alive():
-            self.process.terminate()
-            self.process.join(1.0)
-            if self.process.is_alive():  # SIGTERM not taken within a second: SIGKILL
-                self.process.kill()
-                self.process.join(0.5)
-        self.process = None
+        # taken first: the job thread and the window's exit may both end the worker (the
+        # exit once found self.process None between the two is_alive checks)
+        process, self.process = self.process, None
+        if process is not None and process.is_alive():
+            process.terminate()
+            process.join(1.0)
+            if process.is_alive():  # SIGTERM not taken within a second: SIGKILL
+                process.kill()
+                process.join(0.5)
 
     def shutdown(self) -> None:
         """End the worker within ~2 s: ask (cancel the job, then the end-of-tasks mark),

@@ -14,6 +14,10 @@ def legend_lines(state: AppState) -> list[str]:
     lines = [f"{scene.name or 'scene'}: {render.shading} shading, "
              f"{'Blinn-Phong' if render.specular == 'blinn' else 'Phong'} specular, "
              f"exposure {render.exposure:.3g}, Ia {tuple(round(c, 3) for c in scene.Ia)}"]
+    if state.view.terms_off:   # the picture is not the whole equation: say which terms left
+        from shadelab.shading.codes import TERMS
+
+        lines[0] += ", terms off: " + ", ".join(t for t in TERMS if t in state.view.terms_off)
     for light in scene.active_lights():
         att = light.attenuation
         if att == "lecture":

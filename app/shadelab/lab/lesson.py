@@ -13,6 +13,8 @@ A lesson is a TOML file in ``presets/lessons/`` (or a path)::
     focus = "Materials"            # optional; panels brought to the front (comma-separated)
     show = ["compare"]             # optional; view toggles on for this step (compare, diff,
                                    # normals, wireframe, patches), the others off
+    controls = ["materials.plastic.ka", "Ia"]  # optional, at most 4: the parameters the
+                                   # slide is about (--set paths), shown large on stage
 
 Loading a lesson checks every step (its preset loads with its overrides) so a typo fails at
 start with one line, not in front of the class at step 7.
@@ -58,6 +60,7 @@ def go_to(state, index: int) -> bool:
     apply_pipeline(state, step.pipeline)
     for name, attr in SHOW_TOGGLES.items():
         setattr(state.view, attr, name in step.show)
+    state.view.terms_off = frozenset()   # every step starts from the whole equation
     if step.focus:
         state.walk.focus_request = step.focus
     run.loaded = (state.scene_version, state.scene.version)   # prefetch key: till an edit

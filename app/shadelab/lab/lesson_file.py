@@ -11,7 +11,7 @@ from shadelab.errors import ShadeLabError
 from shadelab.scene.model import Scene
 from shadelab.scene.preset import load_preset, read_toml
 
-STEP_KEYS = {"title", "caption", "preset", "set", "pipeline", "focus", "show"}
+STEP_KEYS = {"title", "caption", "preset", "set", "pipeline", "focus", "show", "controls"}
 # View toggles a step may switch on (every other one is off while the step shows):
 # A lesson step's ``show`` names and the ViewState fields they switch on (state.view).
 SHOW_TOGGLES = {"compare": "compare", "diff": "diff_enabled", "normals": "show_normals",
@@ -51,6 +51,7 @@ class Step:
     pipeline: str = ""
     focus: str = ""
     show: list[str] = field(default_factory=list)   # SHOW_TOGGLES names
+    controls: list[str] = field(default_factory=list)  # dotted paths, shown on stage
 
 
 @dataclass
@@ -102,13 +103,17 @@ def load_lesson(name_or_path: str, check: bool = True) -> Lesson:
         if bad:
             raise ShadeLabError(f"{where}: steps[{i}]: show: unknown '{bad[0]}' "
                                 f"(expected {', '.join(SHOW_TOGGLES)})")
+        controls = item.get("controls", [])
+        if not isinstance(controls, list) or not all(isinstance(c, str) for c in controls):
+            raise ShadeLabError(f"{where}: steps[{i}]: 'controls' must be a list of dotted "
+                                "paths such as \"materials.plastic.n\"")
         _check_pipeline_and_focus(where, i, item)
         preset = item["preset"]
         if not Path(preset).is_absolute() and preset.endswith(".toml"):
             preset = str(path.parent / preset)  # a preset file next to the lesson
         steps.append(Step(item["title"], item["caption"], preset, list(overrides),
                           str(item.get("pipeline", "")), str(item.get("focus", "")),
-                          list(show)))
+                          list(show), list(controls)))
     name = raw.get("name", path.stem)
     if not isinstance(name, str) or not name.strip():
         raise ShadeLabError(f"{where}: key 'name': expected a non-empty string")
@@ -116,7 +121,10 @@ def load_lesson(name_or_path: str, check: bool = True) -> Lesson:
     if check:
         for i, step in enumerate(lesson.steps):
             try:
-                step_scene(step)
+                scene = step_scene(step)
+                from shadelab.lab.controls import check_controls
+
+                check_controls(scene, step.controls)
             except ShadeLabError as exc:
                 raise ShadeLabError(f"{where}: steps[{i}] ('{step.title}'): {exc}") from None
     return lesson

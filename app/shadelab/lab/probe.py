@@ -137,8 +137,11 @@ def _facing(n: np.ndarray, face_normal: np.ndarray, to_eye: np.ndarray) -> np.nd
 
 
 def probe(scene: Scene, size: tuple[int, int], pixel: tuple[int, int], shading: str | None = None,
-          specular: str | None = None, meshes: list[MeshData] | None = None) -> ProbeResult | None:
-    """Every term of the lecture's equation at the surface point under ``pixel``; None on a miss."""
+          specular: str | None = None, meshes: list[MeshData] | None = None,
+          off=()) -> ProbeResult | None:
+    """Every term of the lecture's equation at the surface point under ``pixel``; None on a miss.
+    ``off``: the terms switched off (:func:`shadelab.shading.reference.shade_terms`), as the
+    viewport draws them."""
     shading = shading or scene.render.shading
     specular = specular or scene.render.specular
     hit = cast_pixel(scene, size, pixel, meshes)
@@ -156,25 +159,26 @@ def probe(scene: Scene, size: tuple[int, int], pixel: tuple[int, int], shading: 
     else:
         normal = _facing(normalize(hit.bary @ mesh.corner_normals[face]), fn, to_eye)
     shadow, fade = None, 0.0
-    if scene.render.shadows == "volumes" and material.kt <= 0.0 and lights:
+    if scene.render.shadows == "volumes" and material.kt <= 0.0 and lights \
+            and "shadow" not in off:
         # the stencil's S_i at this pixel; transparent surfaces are drawn unshadowed
         shadow = probe_shadows(scene, hit.point, _facing(fn, fn, to_eye), lights)
         if shading != "flat":  # the point's own threshold (geometry/normals.threshold_at)
             fade = threshold_at(mesh.corner_terminators[face], mesh.corner_normals[face],
                                 np.asarray(hit.bary, dtype=np.float64))
     terms = shade_terms(hit.point, normal, eye, material, lights, scene.Ia, specular, shadow,
-                        terminator=fade)
+                        terminator=fade, off=off)
     if shading == "flat":
         centroid = corners.mean(axis=0)
         n_c = _facing(fn, fn, normalize(eye - centroid))
         reference = shade_terms(centroid, n_c, eye, material, lights, scene.Ia, specular,
-                                shadow).total
+                                shadow, off=off).total
     elif shading == "gouraud":
         n_v = _facing(mesh.corner_normals[face], np.broadcast_to(fn, (3, 3)), eye - corners)
         at_corners = None if shadow is None else [np.broadcast_to(s, (3, 3)) for s in shadow]
         at_t = 0.0 if shadow is None else mesh.corner_terminators[face]  # the corners' t_v
         colors = shade_terms(corners, n_v, eye, material, lights, scene.Ia, specular,
-                             at_corners, terminator=at_t).total
+                             at_corners, terminator=at_t, off=off).total
         reference = hit.bary @ colors
     else:
         reference = terms.total

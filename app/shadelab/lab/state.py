@@ -102,6 +102,10 @@ class ViewState:
     wipe_pipeline: str = "raytrace"
     wipe_position: float = 0.5        # share of the viewport's width left of the wipe line
     radiosity_patches: bool = False   # radiosity pipeline: draw the patch edges
+    # The equation's terms switched off in the raster image and the probe (a click on the
+    # caption's term, issue 22): names of shadelab.shading.codes.TERMS; a view setting, never
+    # saved with the preset, back to none at every lesson step
+    terms_off: frozenset = frozenset()
     pipeline_view: PipelineView | None = None  # the pipeline's jobs and images
 
     @property

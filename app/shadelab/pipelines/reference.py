@@ -16,8 +16,10 @@ from shadelab.scene.model import Scene
 from shadelab.scene.preset import clone_scene
 
 
-def iter_reference_raster(scene: Scene, size: tuple[int, int], rows_per_chunk: int = 8):
-    """A CPU render with the numpy reference (ray cast + Phong-mode shading), rows at a time."""
+def iter_reference_raster(scene: Scene, size: tuple[int, int], rows_per_chunk: int = 8,
+                          off=()):
+    """A CPU render with the numpy reference (ray cast + Phong-mode shading, no S_i), rows
+    at a time; ``off``: the equation's terms switched off (shade_terms' ``off``)."""
     from shadelab.geometry.mesh import scene_meshes
     from shadelab.lab.probe import Picker, _facing
     from shadelab.shading.reference import normalize, shade
@@ -43,7 +45,7 @@ def iter_reference_raster(scene: Scene, size: tuple[int, int], rows_per_chunk: i
             n = normalize(np.einsum("ij,ijk->ik", bary[sel], mesh.corner_normals[f]))
             n = _facing(n, mesh.face_normals[f], normalize(eye - p))
             out[sel] = shade(p, n, eye, scene.materials[mesh.material], scene.active_lights(),
-                             scene.Ia, scene.render.specular)
+                             scene.Ia, scene.render.specular, off=off)
         image[y0:y0 + rows_per_chunk] = out.reshape(-1, width, 3)
         done = min(y0 + rows_per_chunk, height)
         yield Progress(image.copy(), done / height, f"rows {done}/{height}")

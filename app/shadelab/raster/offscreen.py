@@ -28,9 +28,10 @@ def shared_target(size: tuple[int, int]) -> RenderTarget:
 
 
 def render_image(scene: Scene, size: tuple[int, int], shading: str | None = None,
-                 specular: str | None = None) -> np.ndarray:
-    """Linear RGB (H, W, 3) float32 of the scene, row 0 at the top."""
+                 specular: str | None = None, terms_off: int = 0) -> np.ndarray:
+    """Linear RGB (H, W, 3) float32 of the scene, row 0 at the top (``terms_off``: the
+    equation's terms left out, :meth:`Renderer.render`)."""
     renderer = shared_renderer()
     target = shared_target(size)
-    renderer.render(scene, target, shading, specular)
+    renderer.render(scene, target, shading, specular, terms_off)
     return target.read()

@@ -28,7 +28,7 @@ from shadelab.raster.textures import TextureCache, has_surface_detail
 from shadelab.raster.transparency import draw_transparent
 from shadelab.scene.camera import clip_from_world, far_plane, gl_matrix
 from shadelab.scene.model import MAX_LIGHTS, Light, Material, Scene
-from shadelab.shading.codes import ATTENUATION_CODES, CODE_BITS, SPECULAR_CODES
+from shadelab.shading.codes import ATTENUATION_CODES, CODE_BITS, SPECULAR_CODES, TERM_BITS
 from shadelab.shading.lights import light_kind
 from shadelab.shading.packing import (
     PackedMaterial,
@@ -86,6 +86,7 @@ class ProgramUniforms:
         self.Ia_values: tuple = ()
         self.view: View | None = None  # the view whose matrix and eye the program holds
         self.ambient_on = 1.0
+        self.terms_off = 0      # the u_terms_off bits (TERM_AMBIENT is folded into u_ambient)
         self.materials: dict[tuple, list[tuple[str, bytes]]] = {}  # folded writes, per frame
 
 
@@ -125,6 +126,7 @@ class Renderer:
         self.textures = TextureCache(ctx)
         self._gpu: dict[int, GpuMesh] = {}
         self._shadows = None  # shadelab.raster.shadows.ShadowVolumes, made on first use
+        self.terms_off = 0    # the frame's u_terms_off bits (render's ``terms_off``)
 
     @staticmethod
     def light_signature_of(lights: list[Light], specular: str) -> tuple:
@@ -255,6 +257,7 @@ class Renderer:
             state.Ia_values, state.Ia = Ia, np.asarray(Ia, dtype=np.float64)
             cache.write("u_Ia", struct.pack("3f", *Ia))
         cache.write("u_specular_model", struct.pack("i", SPECULAR_CODES[specular]))
+        cache.write("u_terms_off", struct.pack("i", self.terms_off))
         self.set_frame_lights(program, scene.active_lights() if lights is None else lights,
                               ambient_on)
 
@@ -264,7 +267,7 @@ class Renderer:
         premultiplied material uniforms are folded from them at the next draw."""
         state = self.uniforms(program)
         key, arrays = self._lights_packed(lights)
-        frame = (key, state.Ia_values, ambient_on)
+        frame = (key, state.Ia_values, ambient_on, self.terms_off)
         if frame == state.lights_key:
             return  # what the cache wrote last time
         for name, array in arrays.items():
@@ -274,6 +277,7 @@ class Renderer:
         state.ip_s = (arrays["u_light_Ip"].astype(np.float64)
                       * arrays["u_light_S"].astype(np.float64)[:, None])
         state.ambient_on = ambient_on
+        state.terms_off = self.terms_off
         state.materials.clear()
 
     def _lights_packed(self, lights: list[Light]) -> tuple[str, dict[str, np.ndarray]]:
@@ -332,8 +336,12 @@ class Renderer:
 
     # ------------------------------------------------------------ passes
     def render(self, scene: Scene, target: RenderTarget, shading: str | None = None,
-               specular: str | None = None) -> View:
-        """Draw one frame into ``target``; returns the view used."""
+               specular: str | None = None, terms_off: int = 0) -> View:
+        """Draw one frame into ``target``; returns the view used. ``terms_off``: the
+        equation's terms left out (:data:`shadelab.shading.codes.TERM_BITS`, lighting.glsl's
+        ``u_terms_off``); with the shadow term off the shadow volumes' stencil passes are
+        skipped (S_i = 1) and only their teaching overlays stay."""
+        self.terms_off = int(terms_off)
         shading = shading or scene.render.shading
         specular = specular or scene.render.specular
         settings = scene.render
@@ -341,9 +349,10 @@ class Renderer:
         lights = scene.active_lights()[:MAX_LIGHTS]
         self.use_lights(lights, specular)
         painter = settings.visibility == "painter"
-        shadowed = settings.shadows == "volumes" and bool(lights) and not painter
+        volumes_on = settings.shadows == "volumes" and bool(lights) and not painter
+        shadowed = volumes_on and not self.terms_off & TERM_BITS["shadow"]
         # Shadow volumes reach infinity (w = 0): the whole frame then uses an infinite far plane.
-        view = self.view_for(scene, target.size, gpu_meshes, shadowed)
+        view = self.view_for(scene, target.size, gpu_meshes, volumes_on)
         opaque = [g for g in gpu_meshes if not is_transparent(scene.materials[g.mesh.material])]
         clear = [g for g in gpu_meshes if is_transparent(scene.materials[g.mesh.material])]
         # --- PASS 1: clear color, depth and stencil
@@ -378,8 +387,8 @@ class Renderer:
                 self.set_frame_uniforms(variant, scene, view, specular)
             draw_transparent(self, scene, clear, shading, view)
         # --- PASS 5: teaching overlays: stencil heat map, translucent volumes, silhouettes
-        if shadowed and (settings.stencil_heatmap or settings.show_volumes
-                         or settings.show_silhouettes):
+        if volumes_on and (settings.stencil_heatmap or settings.show_volumes
+                           or settings.show_silhouettes):
             self._shadow_overlays(scene, target, view, gpu_meshes, lights)
         self.ctx.enable_only(moderngl.DEPTH_TEST)
         return view
@@ -594,8 +603,9 @@ def _material_writes(state: ProgramUniforms, packed: PackedMaterial) -> list[tup
     (:func:`shadelab.shading.packing.premultiplied_uniforms`)."""
     cache = state.cache
     writes = [(name, data) for name, data in material_uniforms(packed).items() if name in cache]
-    if state.premultiplied:
-        folded = premultiplied_uniforms(packed, state.Ia, state.ip_s, state.ambient_on)
+    if state.premultiplied:   # the ambient term switched off: Ia ka Od folded away
+        Ia = 0.0 * state.Ia if state.terms_off & TERM_BITS["ambient"] else state.Ia
+        folded = premultiplied_uniforms(packed, Ia, state.ip_s, state.ambient_on)
         if "u_ambient" in cache:
             writes.append(("u_ambient", folded["u_ambient"].tobytes()))
         for name in ("u_light_diffuse", "u_light_specular"):

@@ -19,6 +19,13 @@ from shadelab.shading.lights import LIGHT_CLASSES
 LIGHT_KIND_CODES = {cls.kind: cls.code for cls in LIGHT_CLASSES}  # Light.kind, from lights.py
 ATTENUATION_CODES = {"none": 0, "inverse_square": 1, "lecture": 2}  # Light.attenuation
 SPECULAR_CODES = {"phong": 0, "blinn": 1}  # (R.V)^n or (N.H)^n
+# The equation's terms a viewer may switch off one by one (issue 22: click a term of the
+# caption): ambient Ia ka Od, diffuse kd Od (N.L_i), specular ks Os (R_i.V)^n, the attenuation
+# f_att,i (off: 1) and the shadow factor S_i (off: 1). One bit each in ``u_terms_off``
+# (lighting.glsl's TERM_AMBIENT ...); shadelab.shading.reference.shade_terms(off=...) is the
+# numpy truth.
+TERM_BITS = {"ambient": 1, "diffuse": 2, "specular": 4, "attenuation": 8, "shadow": 16}
+TERMS = tuple(TERM_BITS)
 
 assert tuple(LIGHT_KIND_CODES) == LIGHT_KINDS
 assert tuple(cls.kind for cls in LIGHT_CLASSES if cls.aimed) == AIMED_LIGHT_KINDS
@@ -32,7 +39,7 @@ assert max(ATTENUATION_CODES.values()) < 1 << CODE_BITS
 
 # GLSL name prefix of each table: LIGHT_SPOT, ATTENUATION_LECTURE, SPECULAR_BLINN
 _GLSL_TABLES = (("LIGHT", LIGHT_KIND_CODES), ("ATTENUATION", ATTENUATION_CODES),
-                ("SPECULAR", SPECULAR_CODES))
+                ("SPECULAR", SPECULAR_CODES), ("TERM", TERM_BITS))
 
 
 def glsl_defines() -> dict[str, object]:
@@ -41,6 +48,16 @@ def glsl_defines() -> dict[str, object]:
     for prefix, table in _GLSL_TABLES:
         defines.update({f"{prefix}_{name.upper()}": code for name, code in table.items()})
     return defines
+
+
+def terms_mask(off) -> int:
+    """The ``u_terms_off`` bits of the term names in ``off`` (an unknown name: ValueError)."""
+    mask = 0
+    for name in off:
+        if name not in TERM_BITS:
+            raise ValueError(f"term '{name}': expected one of {', '.join(TERMS)}")
+        mask |= TERM_BITS[name]
+    return mask
 
 
 def glsl_header() -> str:

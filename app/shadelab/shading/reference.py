@@ -16,6 +16,7 @@ import numpy as np
 
 from shadelab.constants import SHADING_EPS as _EPS
 from shadelab.scene.model import Light, Material
+from shadelab.shading.codes import TERM_BITS, TERMS, terms_mask  # noqa: F401 (switchable)
 from shadelab.shading.lights import attenuation, light_kind, spot_factor  # noqa: F401
 from shadelab.shading.vectors import dot as _dot
 from shadelab.shading.vectors import normalize
@@ -95,6 +96,10 @@ def light_vectors(light: Light, position: np.ndarray) -> tuple[np.ndarray, np.nd
     return light_kind(light).to_light(position)
 
 
+TERM_AMBIENT, TERM_DIFFUSE, TERM_SPECULAR, TERM_ATTENUATION, TERM_SHADOW = (
+    TERM_BITS[name] for name in ("ambient", "diffuse", "specular", "attenuation", "shadow"))
+
+
 @dataclass
 class LightTerms:
     """One light's contribution at each point, split the way the lecture writes it."""
@@ -154,7 +159,7 @@ def terminator_softening(n_dot_l: np.ndarray, threshold) -> np.ndarray:
 def shade_terms(position: np.ndarray, normal: np.ndarray, eye: np.ndarray, material: Material,
                 lights: list[Light], Ia, specular: str = "phong",
                 shadow: list[np.ndarray] | None = None,
-                od: np.ndarray | None = None, terminator=0.0) -> ShadeTerms:
+                od: np.ndarray | None = None, terminator=0.0, off=()) -> ShadeTerms:
     """Every term of the lecture's equation at each point.
 
     Parameters
@@ -171,6 +176,10 @@ def shade_terms(position: np.ndarray, normal: np.ndarray, eye: np.ndarray, mater
     od : (..., 3) optional per-point diffuse color (textures), replacing material.Od
     terminator : the terminator threshold t (shadow volumes on), a number or (...) per point;
         S_i is multiplied by :func:`terminator_softening` (N.L_i, t). 0 (the default): none
+    off : names from :data:`TERMS` switched off (issue 22, a click on the caption's term):
+        "ambient" (Ia ka Od = 0; Le stays), "diffuse" and "specular" (= 0), "attenuation"
+        (f_att,i = 1) and "shadow" (S_i = 1, the terminator fade with it); lighting.glsl's
+        ``u_terms_off`` bits mirror them
 
     Notes
     -----
@@ -184,13 +193,22 @@ def shade_terms(position: np.ndarray, normal: np.ndarray, eye: np.ndarray, mater
     shape = position.shape[:-1]
     od_arr, os_arr = _material_arrays(material, od, shape)
     to_eye = normalize(np.asarray(eye, dtype=np.float64) - position)
+    mask = terms_mask(off)
     ambient = np.asarray(Ia, dtype=np.float64) * material.ka * od_arr
+    if mask & TERM_AMBIENT:
+        ambient = np.zeros_like(ambient)
+    kd = 0.0 if mask & TERM_DIFFUSE else material.kd
+    ks = 0.0 if mask & TERM_SPECULAR else material.ks
+    if mask & TERM_SHADOW:
+        shadow, terminator = None, 0.0
     spec_fn = blinn_phong_specular if specular == "blinn" else phong_specular
     terms = []
     for i, light in enumerate(lights):
         kind = light_kind(light)
         to_light, distance = kind.to_light(position)
         f_att = kind.attenuation(distance)
+        if mask & TERM_ATTENUATION:
+            f_att = np.ones_like(f_att)
         spot = kind.spot(to_light)
         s = np.ones(shape) if shadow is None else np.asarray(shadow[i], dtype=np.float64)
         rgb = s.shape == shape + (3,) and shadow is not None   # kt-filtered S_i per channel
@@ -201,8 +219,8 @@ def shade_terms(position: np.ndarray, normal: np.ndarray, eye: np.ndarray, mater
             s = s * (soft[..., None] if rgb else soft)
         s3 = s if rgb else s[..., None]
         scale = s3 * (f_att * spot)[..., None] * np.asarray(light.Ip, dtype=np.float64)
-        diffuse = scale * material.kd * od_arr * lambert(n, to_light)[..., None]
-        spec = scale * material.ks * os_arr * spec_fn(n, to_light, to_eye, material.n)[..., None]
+        diffuse = scale * kd * od_arr * lambert(n, to_light)[..., None]
+        spec = scale * ks * os_arr * spec_fn(n, to_light, to_eye, material.n)[..., None]
         terms.append(LightTerms(to_light, distance, f_att, attenuation_clamped(distance, light),
                                 spot, s, diffuse, spec))
     emission = np.broadcast_to(np.asarray(material.emission, dtype=np.float64), shape + (3,))
@@ -212,7 +230,7 @@ def shade_terms(position: np.ndarray, normal: np.ndarray, eye: np.ndarray, mater
 def shade(position: np.ndarray, normal: np.ndarray, eye: np.ndarray, material: Material,
           lights: list[Light], Ia, specular: str = "phong",
           shadow: list[np.ndarray] | None = None, od: np.ndarray | None = None,
-          terminator=0.0) -> np.ndarray:
+          terminator=0.0, off=()) -> np.ndarray:
     """The lecture's illumination I (..., 3) at each point; see :func:`shade_terms`.
 
     Notes
@@ -220,4 +238,4 @@ def shade(position: np.ndarray, normal: np.ndarray, eye: np.ndarray, material: M
     I = Ia ka Od + sum_i S_i f_att,i Ip,i [kd Od (N.L_i) + ks Os (R_i.V)^n]
     """
     return shade_terms(position, normal, eye, material, lights, Ia, specular, shadow, od,
-                       terminator).total
+                       terminator, off).total

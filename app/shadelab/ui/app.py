@@ -26,6 +26,7 @@ from shadelab.lab.recorder import FrameRecorder
 from shadelab.lab.state import (
     AppState,
 )
+from shadelab.shading.codes import terms_mask
 from shadelab.ui import (
     compare_view,
     equation_panel,
@@ -43,6 +44,7 @@ from shadelab.ui import (
     ray_tree_panel,
     scene_labels,
     scene_panel,
+    stage,
 )
 from shadelab.ui.exercise_panel import draw_exercise_panel
 from shadelab.ui.followups import FollowUps, ViewerOptions, write_window_screenshot
@@ -104,10 +106,11 @@ SHORTCUTS = (
     (K.d, "D", "difference heat map (compare)", _toggle("diff_enabled")),
     (K.r, "R", "reset view", AppState.reset_view),
     (K.s, "S", "screenshot of the viewport", scene_panel.screenshot),
-    (K.f, "F", "presenter mode (large fonts)", _toggle("presenter")),
+    (K.f, "F", "presenter mode (large fonts, the stage)", presenter.toggle_presenter),
     (K.h, "H", "this help", _toggle("show_help")),
     (K.f1, "F1", "this help", _toggle("show_help")),
-    (K.tab, "Tab", "viewport only (hide every panel)", presenter.toggle_panels),
+    (K.tab, "Tab", "the stage (viewport and step controls) / every panel",
+     presenter.toggle_panels),
     (K.f11, "F11", "fullscreen", presenter.toggle_fullscreen),
     (K.page_down, "PgDn", "next lesson step", lesson.next_step),
     (K.page_up, "PgUp", "previous lesson step", lesson.previous_step),
@@ -217,15 +220,17 @@ class Viewer:
         state = self.state
         origin = imgui.get_cursor_screen_pos()
         avail = imgui.get_content_region_avail()
-        # the caption gets its own band under the image: it never hides the scene
+        # the caption gets its own band under the image: it never hides the scene; on stage
+        # the step's controls get a strip under the caption
         band = presenter.caption_band(state, avail.x)
-        size = (max(int(avail.x), 16), max(int(avail.y - band) - 4, 16))
+        strip = stage.strip_height(state)
+        size = (max(int(avail.x), 16), max(int(avail.y - band - strip) - 4, 16))
         if size != state.view.viewport_size and state.probe.pixel is not None:
             state.probe.requested = True  # the same pixel shows another point now
         state.view.viewport_size = size
         if state.walk.lesson is not None:   # the next step's viewport (its prefetch's size)
             state.walk.next_size = (size[0], max(int(avail.y - presenter.next_step_band(
-                state, avail.x)) - 4, 16))
+                state, avail.x) - strip) - 4, 16))
         if state.view.compare:
             compare_view.draw_compare(self, size)
         else:
@@ -235,6 +240,8 @@ class Viewer:
         # rect can hide them
         presenter.draw_viewport_extras(state, origin, size, self.recorder.redrawn, band)
         presenter.draw_lesson_buttons(state, origin, size, band)
+        stage.draw_strip(state, imgui.ImVec2(origin.x, origin.y + avail.y - strip), avail.x,
+                         strip)
         if not state.view.compare and not pipeline_viewport.hides_gizmos(state):
             gizmos.draw(state, origin, size)
         pipeline_viewport.draw_on_top(state, origin, size)   # the shooting patch, over all
@@ -286,7 +293,7 @@ class Viewer:
         return (id(s.scene), s.scene_version, s.scene.version, size, v.compare, v.diff_enabled,
                 v.diff_pair, v.diff_scale, v.show_wireframe, v.show_normals, v.normal_length,
                 s.probe.version, s.offline.overlay_version, s.offline.show_radiosity, v.tonemap,
-                v.show_clipping, presenter.line_px(s), v.antialias, v.msaa,
+                v.show_clipping, presenter.line_px(s), v.antialias, v.msaa, v.terms_off,
                 v.show_face_normals, v.show_normal_diff, v.normal_diff_modes)
 
     def unchanged(self, size: tuple[int, int]) -> bool:
@@ -316,7 +323,7 @@ class Viewer:
             vp.draw_colored_triangles(pane, scene, state.offline.radiosity_soup)
         else:
             pane = vp.draw_scene("main", scene, size, scene.render.shading, scene.render.specular,
-                                 self.samples())
+                                 self.samples(), terms_mask(state.view.terms_off))
         # --- PASS 3: the probe reads the GPU value before any overlay is drawn
         if state.probe.requested:
             update_probe(state, vp, size, display_size, self.samples())
@@ -566,6 +573,8 @@ def run_viewer(state: AppState, options: ViewerOptions) -> int:
 def _run(viewer: Viewer, state: AppState, options: ViewerOptions) -> int:
     if options.test_function is None:
         state.view.pipeline = options.pipeline or state.view.pipeline
+        if state.view.presenter:   # --presenter: the stage, Tab brings the panels
+            state.view.hide_panels = True
         if state.view.pipeline in pipelines.OFFLINE:
             pipelines.warm(state)  # an offline view at start: its process spawns at once
         else:  # else once the first frame is up: on 2 cores its imports delay that frame

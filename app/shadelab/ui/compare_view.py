@@ -8,6 +8,7 @@ from imgui_bundle import imgui
 
 from shadelab.lab import camera_control
 from shadelab.lab.state import COMPARE_LABELS, COMPARE_VIEWS, AppState
+from shadelab.shading.codes import terms_mask
 from shadelab.ui.viewport_host import ViewportHost
 
 
@@ -25,7 +26,9 @@ def draw_compare(viewer: ViewportHost, size: tuple[int, int]) -> None:
     if "compare3" in vp.panes and viewer.unchanged(size):
         panes = [vp.panes[f"compare{i}"] for i in range(len(COMPARE_VIEWS))]
     else:
-        panes = [vp.draw_scene(f"compare{i}", scene, half, shading, specular, viewer.samples())
+        off = terms_mask(state.view.terms_off)   # the caption's switched-off terms
+        panes = [vp.draw_scene(f"compare{i}", scene, half, shading, specular, viewer.samples(),
+                               off)
                  for i, (shading, specular) in enumerate(COMPARE_VIEWS)]
     if state.view.diff_enabled:
         a, b = state.view.diff_pair

@@ -6,7 +6,10 @@ from __future__ import annotations
 import numpy as np
 from imgui_bundle import imgui
 
+from shadelab.lab.caption_terms import TERM_COLORS, TERM_LABELS, toggle_term
 from shadelab.lab.state import AppState
+from shadelab.shading.codes import TERMS
+from shadelab.ui.layout import same_line_if_fits
 from shadelab.ui.panels import (
     DIM_COLOR,
     ERROR_COLOR,
@@ -29,16 +32,35 @@ def _rgb(v, digits: int = 3) -> str:
     return "(" + ", ".join(f"{0.0 if abs(x) < tiny else float(x):.{digits}g}" for x in c) + ")"
 
 
-def _term_row(label: str, value) -> None:
+def _term_row(label: str, value, term: str | None = None) -> None:
+    """A row of the terms table; ``term`` colours its label as the caption colours the term."""
     imgui.table_next_row()
     imgui.table_next_column()
+    if term is not None:
+        imgui.push_style_color(imgui.Col_.text, imgui.ImVec4(*TERM_COLORS[term]))
     imgui.text_wrapped(label)
+    if term is not None:
+        imgui.pop_style_color()
     values = np.asarray(value, dtype=np.float64).reshape(-1)
     for c in range(3):
         imgui.table_next_column()
         if c < len(values):
             v = values[c]  # tiny values short (e.g. 4.0e-66) so narrow columns show them
             imgui.text(f"{v:.4g}" if v == 0 or abs(v) >= 1e-3 else f"{v:.1e}")
+
+
+def draw_term_switches(state: AppState) -> None:
+    """One checkbox per term of the equation, in its colour: unticked, the term is left out of
+    the viewport's image and the probe (the same switch as a click on the caption's term)."""
+    imgui.text("Terms:")
+    for term in TERMS:
+        if same_line_if_fits(term, radio=True):
+            imgui.same_line()
+        imgui.push_style_color(imgui.Col_.text, imgui.ImVec4(*TERM_COLORS[term]))
+        if imgui.checkbox(f"{term}##term", term not in state.view.terms_off)[0]:
+            toggle_term(state, term)
+        imgui.pop_style_color()
+        imgui.set_item_tooltip(f"{TERM_LABELS[term]}: untick to leave it out of the image")
 
 
 def draw_equation_panel(state: AppState) -> bool:
@@ -49,6 +71,7 @@ def draw_equation_panel(state: AppState) -> bool:
     imgui.text_wrapped("f_att = min(1 / (c1 + c2 d + c3 d^2), 1);  "
                        + ("H = (L + V) / |L + V|" if blinn else "R = 2 N (N.L) - L"))
     imgui.text_wrapped(f"Ia = {_rgb(scene.Ia)}   shading: {SHADING_LABELS[scene.render.shading]}")
+    draw_term_switches(state)
     result = state.probe.result
     if result is None:
         imgui.separator()
@@ -80,22 +103,22 @@ def draw_equation_panel(state: AppState) -> bool:
         imgui.table_headers_row()
         terms = result.terms
         _term_row("Le (emission)", terms.emission)
-        _term_row("ambient Ia ka Od", terms.ambient)
+        _term_row("ambient Ia ka Od", terms.ambient, "ambient")
         for i, t in enumerate(terms.lights[:len(lights)]):
             name = lights[i].name or f"light {i}"
             n_dot_l = float(np.dot(result.normal, t.to_light))
             spec_cos = float(np.dot(result.normal if blinn else result.reflected(i),
                                     result.reflected(i) if blinn else result.to_eye))
-            _term_row(f"{name}: d, f_att", (float(t.distance), float(t.f_att)))
+            _term_row(f"{name}: d, f_att", (float(t.distance), float(t.f_att)), "attenuation")
             shadow = np.asarray(t.shadow, dtype=np.float64).reshape(-1)
             if np.ptp(shadow) > 0.0:     # kt-filtered: one S_i per channel
-                _term_row(f"{name}: S_i (r, g, b)", shadow)
+                _term_row(f"{name}: S_i (r, g, b)", shadow, "shadow")
                 _term_row(f"{name}: spot", float(t.spot))
             else:
-                _term_row(f"{name}: S_i, spot", (float(shadow[0]), float(t.spot)))
+                _term_row(f"{name}: S_i, spot", (float(shadow[0]), float(t.spot)), "shadow")
             _term_row(f"{name}: N.L, {'N.H' if blinn else 'R.V'}", (n_dot_l, spec_cos))
-            _term_row(f"{name}: diffuse", t.diffuse)
-            _term_row(f"{name}: specular", t.specular)
+            _term_row(f"{name}: diffuse", t.diffuse, "diffuse")
+            _term_row(f"{name}: specular", t.specular, "specular")
         if result.shading != "phong":
             _term_row("sum at this point", terms.total)
         _term_row(f"I ({result.shading} reference)", result.reference)

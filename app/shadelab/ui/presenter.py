@@ -42,6 +42,18 @@ def toggle_panels(state: AppState) -> None:
     state.view.hide_panels = not state.view.hide_panels
 
 
+def set_presenter(state: AppState, on: bool) -> None:
+    """Presenter mode on: large fonts and the stage (the viewport with the step's controls,
+    the dock panels hidden, Tab brings them back); off: the desk layout with its panels."""
+    if on != state.view.presenter:
+        state.view.hide_panels = on
+    state.view.presenter = on
+
+
+def toggle_presenter(state: AppState) -> None:
+    set_presenter(state, not state.view.presenter)
+
+
 def toggle_fullscreen(state: AppState) -> None:
     state.view.fullscreen = not state.view.fullscreen
 
@@ -221,52 +233,147 @@ def _push_caption_font(scale: float) -> float:
     return got if abs(got - expected) <= 1.0 else expected
 
 
+VALUE_SCALE = 0.6     # the probed values under the caption's terms, share of its font size
+TERM_OFF_COLOR = 0xFF8C8C8C
+
+
+def _u32(rgba) -> int:
+    return imgui.color_convert_float4_to_u32(imgui.ImVec4(*rgba))
+
+
+_layouts: dict[tuple, tuple] = {}   # (text, width, font px) -> (runs, line tops, height)
+
+
+def caption_layout(text: str, width: float, scale: float) -> tuple[list, list, float, float]:
+    """The caption's runs (:func:`shadelab.lab.caption_terms.layout`) wrapped to ``width``
+    pixels at the caption's font, each line's top and the text's height (a row for the
+    probed values under every line that carries a term: the band never changes with the
+    probe), and the font px. Measured at the size it is drawn at."""
+    from shadelab.lab.caption_terms import layout, line_count, lines_with_terms
+
+    pad = 10.0 * scale / 1.4
+    font_px = _push_caption_font(scale)
+    key = (text, round(width, 1), round(font_px, 2))
+    try:
+        cached = _layouts.get(key)
+        if cached is None:
+            got = imgui.get_font_size()
+            k = font_px / got if got > 0 else 1.0   # a stale current size: rescaled
+
+            def measure(t: str) -> float:
+                return imgui.calc_text_size(t).x * k
+            runs = layout(text, max(width - 2 * pad, 50.0), measure)
+            value_row = VALUE_SCALE * font_px + 2.0
+            terms = lines_with_terms(runs)
+            tops, y = [], 0.0
+            for line in range(line_count(runs)):
+                tops.append(y)
+                y += font_px + (value_row if line in terms else 0.0)
+            if len(_layouts) > 256:
+                _layouts.clear()
+            cached = _layouts[key] = (runs, tops, y)
+    finally:
+        imgui.pop_font()
+    runs, tops, y = cached
+    return runs, tops, y, font_px
+
+
 def caption_height(text: str, width: float, scale: float) -> float:
     """Height of the caption band for ``text`` wrapped to ``width`` pixels (0 if no text)."""
     if not text:
         return 0.0
     pad = 10.0 * scale / 1.4
-    font_px = _push_caption_font(scale)
-    try:  # measured at the size it is drawn at (glyph advances do not scale exactly)
-        got = imgui.get_font_size()
-        wrap = max(width - 2 * pad, 50.0)
-        if abs(got - font_px) > 1e-3:   # a stale current size: measure, then rescale
-            text_size = imgui.calc_text_size(text, False, wrap * got / font_px)
-            return text_size.y * font_px / got + 2.5 * pad
-        text_size = imgui.calc_text_size(text, False, wrap)
-    finally:
-        imgui.pop_font()
-    return text_size.y + 2.5 * pad
+    return caption_layout(text, width, scale)[2] + 2.5 * pad
 
 
 # The last caption's font px, line and glyph heights, recorded only while a GUI test sets
-# RECORD_CAPTION (measuring the glyph every frame is work the lecture does not need).
+# RECORD_CAPTION (measuring the glyph every frame is work the lecture does not need); with it
+# the terms drawn: term -> (item id, (x0, y0, x1, y1), value text)
 RECORD_CAPTION = False
 drawn_caption: dict = {}
+drawn_terms: dict = {}
 
 
 def draw_caption(draw, text: str, origin, size, scale: float,
-                 height: float | None = None) -> None:
+                 height: float | None = None, state: AppState | None = None) -> None:
     """Large caption at the bottom of the ``size`` rect at ``origin``, wrapped to its width,
-    on a dark band ``height`` high (:func:`caption_height`, measured here when not given)."""
+    on a dark band ``height`` high (:func:`caption_height`, measured here when not given).
+    Its terms of the equation are drawn in their colours (the Equation & probe window's);
+    with ``state`` each is a button that switches the term off and on in the image, and with
+    a probe set its value at the probed point is written under it."""
     if not text:
         return
     pad = 10.0 * scale / 1.4
-    wrap = max(size[0] - 2 * pad, 50.0)
     if height is None:
         height = caption_height(text, size[0], scale)
+    runs, tops, _, font_px = caption_layout(text, size[0], scale)
     font_size = _push_caption_font(scale)
+    if RECORD_CAPTION:
+        drawn_terms.clear()
     try:
         font = imgui.get_font()
-        x, y = origin.x + pad, origin.y + size[1] - height + pad
+        x0, y0 = origin.x + pad, origin.y + size[1] - height + pad
         draw.add_rect_filled(imgui.ImVec2(origin.x, origin.y + size[1] - height),
                              imgui.ImVec2(origin.x + size[0], origin.y + size[1]), 0xA0000000)
-        draw.add_text(font, font_size, imgui.ImVec2(x + 1, y + 1), CAPTION_SHADOW, text, wrap)
-        draw.add_text(font, font_size, imgui.ImVec2(x, y), CAPTION_COLOR, text, wrap)
+        for k, run in enumerate(runs):
+            x, y = x0 + run.x, y0 + tops[run.line]
+            color = CAPTION_COLOR
+            if run.term:
+                color = _term_color(state, run.term)
+            draw.add_text(font, font_size, imgui.ImVec2(x + 1, y + 1), CAPTION_SHADOW, run.text)
+            draw.add_text(font, font_size, imgui.ImVec2(x, y), color, run.text)
+            if run.term:
+                _live_term(draw, font, state, run, k, x, y, font_size)
         if RECORD_CAPTION:
             _record_caption(font, font_size)
     finally:
         imgui.pop_font()
+
+
+def _term_color(state: AppState | None, term: str) -> int:
+    from shadelab.lab.caption_terms import TERM_COLORS
+
+    if state is not None and term in state.view.terms_off:
+        return TERM_OFF_COLOR
+    return _u32(TERM_COLORS[term])
+
+
+def _live_term(draw, font, state: AppState | None, run, k: int, x: float, y: float,
+               font_px: float) -> None:
+    """One term of the caption: struck through when off, its probed value under it, and
+    (with ``state``) a button over it that switches it."""
+    from shadelab.lab.caption_terms import (
+        TERM_COLORS,
+        term_value_text,
+        terms_switchable,
+        toggle_term,
+    )
+
+    color = _term_color(state, run.term)
+    off = state is not None and run.term in state.view.terms_off
+    if off:
+        mid = y + 0.55 * font_px
+        draw.add_line(imgui.ImVec2(x, mid), imgui.ImVec2(x + run.width, mid), color, 2.0)
+    value = ""
+    if state is not None and (off or state.probe.result is not None):
+        value = term_value_text(state.probe.result, run.term, off)
+    value_px = VALUE_SCALE * font_px
+    if value:
+        draw.add_text(font, value_px, imgui.ImVec2(x, y + font_px + 1.0),
+                      _u32(TERM_COLORS[run.term]) if not off else TERM_OFF_COLOR, value)
+    if state is None or not terms_switchable(state):
+        return
+    rect = (x, y, x + run.width, y + font_px + value_px)
+    imgui.set_cursor_screen_pos(imgui.ImVec2(x, y))
+    if imgui.invisible_button(f"##term {run.term} {k}", imgui.ImVec2(run.width, rect[3] - y)):
+        toggle_term(state, run.term)
+    if imgui.is_item_hovered():
+        imgui.set_mouse_cursor(imgui.MouseCursor_.hand)
+        draw.add_line(imgui.ImVec2(x, y + font_px), imgui.ImVec2(x + run.width, y + font_px),
+                      color, 2.0)
+        imgui.set_item_tooltip(f"click: {run.term} {'on' if off else 'off'} in the image")
+    if RECORD_CAPTION and run.term not in drawn_terms:
+        drawn_terms[run.term] = (imgui.get_item_id(), rect, value)
 
 
 def _record_caption(font, font_size: float) -> None:
@@ -331,10 +438,13 @@ def _lesson_band(state: AppState, width: float) -> float:
 def caption_band(state: AppState, width: float) -> float:
     """Height of the caption band the viewport keeps under its image (0: no caption); in a
     lesson it is measured once for all its steps (the tallest caption at this width and
-    font) and holds a row for the Prev / Next buttons too."""
+    font) and holds a row for the Prev / Next buttons too (on stage they sit in the controls
+    strip instead)."""
     if lesson_running(state):
         height = _lesson_band(state, width)
-        return height + imgui.get_frame_height_with_spacing() if height else height
+        if not height or _buttons_on_stage(state):
+            return height
+        return height + imgui.get_frame_height_with_spacing()
     return caption_height(caption_text(state), width, caption_scale(state))
 
 
@@ -347,10 +457,17 @@ def next_step_band(state: AppState, width: float) -> float:
 LESSON_BUTTONS = ("< Prev (PgUp)", "Next > (PgDn)")
 
 
+def _buttons_on_stage(state: AppState) -> bool:
+    """The lesson's Prev / Next buttons are in the stage's controls strip (ui/stage.py)."""
+    from shadelab.ui.stage import strip_height
+
+    return strip_height(state) > 0
+
+
 def draw_lesson_buttons(state: AppState, origin, size, band: float) -> None:
     """Prev / Next at the bottom right of the caption band: in the viewport, so they stay in
     reach whichever panel a step brings forward (PageUp / PageDown do the same)."""
-    if band <= 0 or not lesson_running(state):
+    if band <= 0 or not lesson_running(state) or _buttons_on_stage(state):
         return
     from shadelab.lab import lesson
 
@@ -386,8 +503,9 @@ def draw_viewport_extras(state: AppState, origin, size, redrawn: bool,
     caption = caption_text(state)
     if band > 0:
         draw_caption(draw, caption, imgui.ImVec2(origin.x, origin.y + size[1]),
-                     (size[0], band + 4), caption_scale(state), band)  # measured once a frame
-    else:
+                     (size[0], band + 4), caption_scale(state), band,  # measured once a frame
+                     state)
+    else:   # over the image: its terms are not buttons (the image takes the clicks)
         draw_caption(draw, caption, origin, size, caption_scale(state))
 
 
@@ -480,7 +598,9 @@ def end_frame(viewer: ViewportHost) -> None:
     dialogs.take_dropped(state)
     dialogs.draw_discard_question(state)
     drop_stale_overlays(state)
-    if state.walk.focus_request:
+    if state.walk.focus_request and not state.view.hide_panels:
+        # (on stage the request waits for Tab: focusing a hidden window would show it over
+        # the stage)
         from shadelab.ui.layout import focus_windows
 
         focus_windows(hello_imgui.get_runner_params().docking_params.dockable_windows,

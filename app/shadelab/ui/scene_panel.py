@@ -216,7 +216,9 @@ def draw_scene_panel(state: AppState) -> bool:
     edited = draw_render_panel(state)
     imgui.separator()
     draw_compare_panel(state)
-    _, state.view.presenter = imgui.checkbox("Presenter mode (F)", state.view.presenter)
+    changed, on = imgui.checkbox("Presenter mode (F)", state.view.presenter)
+    if changed:   # on: the stage (the panels hidden, Tab brings them back)
+        presenter.set_presenter(state, on)
     imgui.same_line()
     _, state.view.show_help = imgui.checkbox("Help (H)", state.view.show_help)
     if imgui.button("Screenshot (S)"):

@@ -91,11 +91,12 @@ class Viewport:
         return pane
 
     def draw_scene(self, key: str, scene: Scene, size: tuple[int, int], shading: str,
-                   specular: str, samples: int = 1) -> Pane:
+                   specular: str, samples: int = 1, terms_off: int = 0) -> Pane:
         """PASS 1-2 (the Renderer): the scene into the pane's float target (``samples``: MSAA,
-        resolved when the pane is presented or read)."""
+        resolved when the pane is presented or read; ``terms_off``: the equation's terms
+        switched off, shadelab.shading.codes.TERM_BITS)."""
         pane = self.pane(key, size, samples)
-        pane.view = self.renderer.render(scene, pane.target, shading, specular)
+        pane.view = self.renderer.render(scene, pane.target, shading, specular, terms_off)
         return pane
 
     def draw_colored_triangles(self, pane: Pane, scene: Scene, soup: np.ndarray) -> None:

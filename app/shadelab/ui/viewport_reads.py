@@ -8,6 +8,7 @@ from pathlib import Path
 
 from shadelab.lab.probe import probe
 from shadelab.lab.state import AppState
+from shadelab.shading.codes import terms_mask
 
 
 def update_probe(state: AppState, viewport, size: tuple[int, int],
@@ -27,13 +28,14 @@ def update_probe(state: AppState, viewport, size: tuple[int, int],
     pixel = (min(int(shown[0] * size[0] / display_size[0]), size[0] - 1),
              min(int(shown[1] * size[1] / display_size[1]), size[1] - 1))
     state.probe.requested = False
-    result = probe(state.scene, size, pixel)
+    off = state.view.terms_off
+    result = probe(state.scene, size, pixel, off=off)
     if result is not None and not state.offline.show_radiosity:
         key = "main"
         if samples > 1:  # a resolved edge pixel averages both sides: read 1 sample
             key = "probe"
             viewport.draw_scene(key, state.scene, size, state.scene.render.shading,
-                                state.scene.render.specular)
+                                state.scene.render.specular, terms_off=terms_mask(off))
         result.gpu = viewport.read_pixel(key, pixel)
     state.probe.result = result
     state.probe.version += 1
