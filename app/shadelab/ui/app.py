@@ -167,6 +167,7 @@ class Viewer:
 
     def __post_init__(self) -> None:
         self.followups = FollowUps(self.options)
+        self.recorder.breakdown = bool(self.options.bench_json)  # the frame's parts, timed
 
     # ------------------------------------------------------------ GL lifetime
     def post_init(self) -> None:
@@ -201,13 +202,21 @@ class Viewer:
         if self.options.bench_json:
             self.recorder.write(self.options.bench_json, self.options.window_size,
                                 pipelines.bench_report(self.state)  # jobs: first_image_s...
-                                | self.followups.bench_extra())
+                                | self.followups.bench_extra()
+                                | {"triangles": self.triangles()})
         if self.gpu is not None:
             self.gpu.release()
             self.gpu = None
         if self.viewport is not None:
             self.viewport.release()
             self.viewport = None
+
+    def triangles(self) -> int | None:
+        """The scene's triangle count (the bench's report), None when a mesh does not load."""
+        try:
+            return sum(len(m.faces) for m in scene_meshes(self.state.scene))
+        except Exception:  # a broken edit: the report is still written
+            return None
 
     # ------------------------------------------------------------ viewport window
     def draw_viewport_window(self) -> None:
@@ -224,7 +233,8 @@ class Viewer:
             state.walk.next_size = (size[0], max(int(avail.y - presenter.next_step_band(
                 state, avail.x)) - 4, 16))
         if state.view.compare:
-            compare_view.draw_compare(self, size)
+            with self.recorder.part("scene"):
+                compare_view.draw_compare(self, size)
         else:
             self.draw_main(size)
         # the caption and fps readout first: nothing the gizmo does to the draw list's clip
@@ -302,6 +312,7 @@ class Viewer:
             self._handle_click(self.image_with_input(vp.panes["main"].display, display_size),
                                display_size)
             return
+        self.recorder.begin("scene")  # the bench's breakdown: PASS 1-5 (read-backs apart)
         # --- PASS 1-2: the scene into the float target (the Renderer's passes), or the solved
         # radiosity meshes, Gouraud-interpolated (view-independent: walk around them)
         radiosity = state.offline.show_radiosity and state.offline.radiosity_soup is not None
@@ -313,7 +324,8 @@ class Viewer:
                                  self.samples())
         # --- PASS 3: the probe reads the GPU value before any overlay is drawn
         if state.probe.requested:
-            update_probe(state, vp, size, display_size, self.samples())
+            with self.recorder.part("readback"):
+                update_probe(state, vp, size, display_size, self.samples())
         # --- PASS 4: overlays (wireframe, normal glyphs, probe arrows)
         exposure = scene.render.exposure
         meshes = scene_meshes(scene)
@@ -333,8 +345,10 @@ class Viewer:
         texture = vp.present(pane, exposure, tonemap=state.view.tonemap,
                              clipping=state.view.show_clipping)
         if state.screenshot_requested:
-            write_viewport_screenshot(state, vp, state.screenshot_requested)
+            with self.recorder.part("readback"):
+                write_viewport_screenshot(state, vp, state.screenshot_requested)
             state.screenshot_requested = ""
+        self.recorder.end("scene")
         self._handle_click(self.image_with_input(texture, display_size), display_size)
 
     def samples(self) -> int:
@@ -379,7 +393,9 @@ class Viewer:
     def begin_frame(self) -> None:
         """Before any panel draws: the GPU work and images the panels queued last frame."""
         if self.gpu is not None:
-            guarded(lambda: self.gpu.flush(self.state.gpu), "GPU requests", self.report_error)
+            with self.recorder.part("gpu_requests"):
+                guarded(lambda: self.gpu.flush(self.state.gpu), "GPU requests",
+                        self.report_error)
             guarded(lambda: offline.update(self.state), "offline job", self.report_error)
         gizmos.begin_frame()
 
@@ -527,6 +543,11 @@ def runner_params(viewer: Viewer) -> hello_imgui.RunnerParams:
     params.callbacks.before_exit = viewer.before_exit
     params.callbacks.post_new_frame = viewer.begin_frame
     params.callbacks.after_swap = viewer.frame_swapped
+    # the bench's breakdown of a frame: the GUI built (panels, viewport passes within), then
+    # ImGui's draw lists drawn and the swap (FrameRecorder.frame_swapped ends that part)
+    params.callbacks.pre_new_frame = lambda: viewer.recorder.begin("gui")
+    params.callbacks.before_imgui_render = lambda: (viewer.recorder.end("gui"),
+                                                    viewer.recorder.begin("gui_render"))
     params.callbacks.show_gui = lambda: guarded(viewer.end_frame, "frame", viewer.report_error)
     return params
 
