@@ -42,7 +42,8 @@ NOTE = ("cases: each case runs the viewer, then Polyscope, on one display; frame
         "threads: llvmpipe rasterizes there); scene_cpu_ms = redraw cpu - idle cpu; polyscope: "
         "the same triangles, window and display, every frame redrawn, vsync off; "
         "fps_over_polyscope = fps / polyscope fps (both redraw every frame); first_frame_s: "
-        "from process start (imports included), after one unmeasured start (warm caches)")
+        "from process start (imports included), after one unmeasured start (warm caches); "
+        "first_frame_cpu_s: the process's CPU seconds until then (steadier under load)")
 
 
 def case_name(preset: str, window: str, presenter: bool, overrides=()) -> str:
@@ -84,7 +85,9 @@ def on_display(commands: list[list[str]]) -> list[str] | None:
 def warm_environment(folder: str) -> tuple[dict, str]:
     """The subprocesses' environment and where their bytecode is cached: Python's own
     ``__pycache__`` folders, or (``PYTHONDONTWRITEBYTECODE`` set) ShadeLab's cache folder."""
-    env = dict(os.environ, XDG_STATE_HOME=folder,
+    # no background `shadelab warm` compiling kernels beside the measured frames (a cold
+    # kernel cache is reported as kernel_cache_warm false; `shadelab warm` warms it)
+    env = dict(os.environ, XDG_STATE_HOME=folder, SHADELAB_AUTOWARM="0",
                PYTHONPATH=str(Path(__file__).resolve().parents[2]))
     env.pop("PYOPENGL_PLATFORM", None)  # the viewer is GLX, never EGL
     bytecode = "__pycache__ (Python's default)"
@@ -170,6 +173,7 @@ def case_figures(report: dict) -> dict:
            "idle_frame_ms_median": idle, "idle_cpu_ms_median": report.get("idle_cpu_ms_median"),
            "idle_fps": 1000.0 / idle if idle else None,
            "first_frame_s": report.get("first_frame_s"),
+           "first_frame_cpu_s": report.get("first_frame_cpu_s"),
            "breakdown": {phase: report[f"{phase}_breakdown"]
                          for phase in ("redraw", "interactive", "idle")
                          if f"{phase}_breakdown" in report}}
@@ -188,9 +192,11 @@ def summary(cases: dict, idle: dict, frames: int, wall: float, bytecode: str) ->
     out = {"frames": frames, "cases": cases,
            "fps_over_polyscope_min": min(measured) if measured else None,
            "first_frame_s": first.get("first_frame_s"),
+           "first_frame_cpu_s": first.get("first_frame_cpu_s"),
            "first_frame_s_max": max((c["first_frame_s"] for c in cases.values()
                                      if c.get("first_frame_s") is not None), default=None),
-           "bytecode_cache": bytecode, "process_wall_s": wall,
+           "bytecode_cache": bytecode, "kernel_cache_warm": kernel_cache_warm(),
+           "process_wall_s": wall,
            "load_average": os.getloadavg()[0], "note": NOTE}
     for key in ("window", "preset", "fps", "frame_ms_median", "frame_cpu_ms_median",
                 "idle_frame_ms_median", "idle_cpu_ms_median", "fps_over_polyscope"):
@@ -207,6 +213,14 @@ def summary(cases: dict, idle: dict, frames: int, wall: float, bytecode: str) ->
         "idle_cpu_mesh80k_over_cornell": (big_cpu / small_cpu
                                           if small_cpu and big_cpu else None)}
     return out
+
+
+def kernel_cache_warm() -> bool | None:
+    """Whether ``shadelab warm`` has filled the numba kernel cache (None: no cache folder)."""
+    from shadelab.cli.warm import done_mark
+
+    mark = done_mark()
+    return None if mark is None else mark.exists()
 
 
 def peer_figures(polyscope: dict | None, fps: float | None, idle_ms: float | None,

@@ -40,6 +40,7 @@ PARTS = ("gui", "scene", "gpu_requests", "readback", "gui_render")
 class FrameRecorder:
     started: float = field(default_factory=time.perf_counter)
     first_frame: float = 0.0           # perf_counter of the first frame showing the viewport
+    first_frame_cpu: float = 0.0       # the process's CPU seconds then (every thread)
     frame_times: list = field(default_factory=list)
     cpu_times: list = field(default_factory=list)
     redraw_flags: list = field(default_factory=list)
@@ -100,6 +101,7 @@ class FrameRecorder:
         first = not self.first_frame and self.viewport_shown
         if first:
             self.first_frame = now
+            self.first_frame_cpu = time.process_time()
         self.frame_times.append(now)
         self.cpu_times.append(time.process_time())
         flag = IDLE if not self.redrawn else (INTERACTIVE if self.force_interactive else REDRAW)
@@ -118,6 +120,7 @@ class FrameRecorder:
         times = np.diff(np.asarray(self.frame_times)) * 1000.0
         flags = np.asarray(self.redraw_flags[1:])
         report = {"first_frame_s": self.first_frame_since_start(),
+                  "first_frame_cpu_s": self.first_frame_cpu,
                   "frames": len(self.frame_times), "window": list(window_size)}
         cpu = np.diff(np.asarray(self.cpu_times)) * 1000.0
         for name, flag in PHASES:

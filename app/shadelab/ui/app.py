@@ -39,16 +39,38 @@ from shadelab.ui import (
     pipelines,
     presenter,
     radiosity_view,
-    ray_tree_panel,
     scene_panel,
 )
-from shadelab.ui.exercise_panel import draw_exercise_panel
 from shadelab.ui.followups import FollowUps, ViewerOptions, write_window_screenshot
 from shadelab.ui.frame import guarded
 from shadelab.ui.offline import draw_offline_panel
-from shadelab.ui.render_panel import draw_algorithms_panel
-from shadelab.ui.studies_panel import draw_gallery_panel, draw_studies_panel
 from shadelab.ui.viewport_reads import update_probe, write_viewport_screenshot
+
+
+class LazyPanels:
+    """A panel module imported when one of its windows first draws, not at start-up: the
+    windows behind a tab (Exercise, Studies, Algorithms, Ray tree) and what they import
+    (exercises, studies, the ray tree's layout) stay off the path to the first frame."""
+
+    def __init__(self, module: str):
+        self.module = f"shadelab.ui.{module}"
+
+    def __getattr__(self, name: str) -> Callable:
+        module = self.module
+
+        def draw(state: AppState) -> bool:
+            import importlib
+
+            return getattr(importlib.import_module(module), name)(state)
+
+        draw.__name__ = draw.__qualname__ = name
+        return draw
+
+
+exercise_panel = LazyPanels("exercise_panel")
+render_panel = LazyPanels("render_panel")
+studies_panel = LazyPanels("studies_panel")
+ray_tree_panel = LazyPanels("ray_tree_panel")
 
 PRESENTER_SCALE = 1.8      # font scale of presenter mode
 WARM_JOBS_AT_FRAME = 60    # start the offline-job process once the window is up
@@ -494,12 +516,12 @@ def _docking(viewer: Viewer) -> hello_imgui.DockingParams:
         window("Viewport", "MainDockSpace",
                lambda: guarded(viewer.draw_viewport_window, "viewport", viewer.report_error)),
         window("Equation & probe", "RightSpace", p(equation_panel.draw_equation_panel)),
-        window("Studies", "RightSpace", p(draw_studies_panel)),
-        window("Failure gallery", "RightSpace", p(draw_gallery_panel)),
+        window("Studies", "RightSpace", p(studies_panel.draw_studies_panel)),
+        window("Failure gallery", "RightSpace", p(studies_panel.draw_gallery_panel)),
         window("Offline render", "RightBottom", p(draw_offline_panel)),
-        window("Algorithms", "LeftSpace", p(draw_algorithms_panel)),
+        window("Algorithms", "LeftSpace", p(render_panel.draw_algorithms_panel)),
         window("Hemicube & F", "RightSpace", p(radiosity_view.draw_panel)),
-        window("Exercise", "RightSpace", p(draw_exercise_panel)),
+        window("Exercise", "RightSpace", p(exercise_panel.draw_exercise_panel)),
         window("Ray tree", "RightSpace", p(ray_tree_panel.draw_ray_tree_panel)),
     ]
     for w in params.dockable_windows:
