@@ -41,7 +41,8 @@ NOTE = ("cases: each case runs the viewer, then Polyscope, on one display; frame
         "and the swap) and other_cpu_ms, the rest of the frame's process CPU (the GL driver's "
         "threads: llvmpipe rasterizes there); scene_cpu_ms = redraw cpu - idle cpu; polyscope: "
         "the same triangles, window and display, every frame redrawn, vsync off; "
-        "fps_over_polyscope = fps / polyscope fps (both redraw every frame); first_frame_s: "
+        "fps_over_polyscope = fps / polyscope fps (both redraw every frame), cpu_over_polyscope = "
+        "polyscope's CPU ms per frame / ours; first_frame_s: "
         "from process start (imports included), after one unmeasured start (warm caches); "
         "first_frame_cpu_s: the process's CPU seconds until then (steadier under load)")
 
@@ -150,7 +151,8 @@ def run(quick: bool) -> dict:
             peer = None if peer_json is None else _read(peer_json)
             figures.update(peer_figures(peer, figures.get("fps"),
                                         figures.get("idle_frame_ms_median"),
-                                        None if peer_json is None else ["polyscope"]))
+                                        None if peer_json is None else ["polyscope"],
+                                        figures.get("frame_cpu_ms_median")))
             cases[name] = figures
     if all("error" in c for c in cases.values()):
         return {"skipped": next(iter(cases.values()))["error"], "cases": cases}
@@ -224,8 +226,10 @@ def kernel_cache_warm() -> bool | None:
 
 
 def peer_figures(polyscope: dict | None, fps: float | None, idle_ms: float | None,
-                 command: list[str] | None) -> dict:
-    """Polyscope's figures beside the viewer's, or why there are none."""
+                 command: list[str] | None, cpu_ms: float | None = None) -> dict:
+    """Polyscope's figures beside the viewer's, or why there are none; ``cpu_over_polyscope``:
+    Polyscope's CPU ms per redrawn frame over ours (the same comparison in CPU time, which a
+    shared machine's load disturbs less than wall time)."""
     if command is None:
         from shadelab.bench.goals import INSTALL_PEERS
 
@@ -233,8 +237,10 @@ def peer_figures(polyscope: dict | None, fps: float | None, idle_ms: float | Non
     if polyscope is None:
         return {"polyscope": "failed (no report written)"}
     peer_fps = 1000.0 / polyscope["frame_ms_median"]
+    peer_cpu = polyscope.get("cpu_ms_median")
     return {"polyscope": {**polyscope, "fps": peer_fps},
             "fps_over_polyscope": fps / peer_fps if fps else None,
+            "cpu_over_polyscope": peer_cpu / cpu_ms if peer_cpu and cpu_ms else None,
             "idle_fps_over_polyscope": 1000.0 / idle_ms / peer_fps if idle_ms else None}
 
 

@@ -533,7 +533,7 @@ def _docking(viewer: Viewer) -> hello_imgui.DockingParams:
     return params
 
 
-def clear_with_window_bg() -> None:
+def clear_with_window_bg(params: hello_imgui.RunnerParams | None = None) -> None:
     """The theme's window background becomes the window's clear color, and windows draw none.
 
     llvmpipe is fill-bound: the full-window windows (hello_imgui's dock space host, the
@@ -545,9 +545,9 @@ def clear_with_window_bg() -> None:
     style = imgui.get_style()
     bg = style.color_(imgui.Col_.window_bg)
     if bg.w > 0.0:
-        params = hello_imgui.get_runner_params().imgui_window_params
-        clear = params.background_color
-        params.background_color = imgui.ImVec4(*(c * bg.w + under * (1.0 - bg.w) for c, under in
+        window = (params or hello_imgui.get_runner_params()).imgui_window_params
+        clear = window.background_color
+        window.background_color = imgui.ImVec4(*(c * bg.w + under * (1.0 - bg.w) for c, under in
                                                  ((bg.x, clear.x), (bg.y, clear.y),
                                                   (bg.z, clear.z))), 1.0)
         style.set_color_(imgui.Col_.window_bg, imgui.ImVec4(bg.x, bg.y, bg.z, 0.0))
@@ -575,8 +575,8 @@ def runner_params(viewer: Viewer) -> hello_imgui.RunnerParams:
     gl_options.anti_aliasing_samples = 0
     params.renderer_backend_options.open_gl_options = gl_options
     params.imgui_window_params.background_color = WINDOW_BG
-    params.callbacks.setup_imgui_style = clear_with_window_bg  # after the theme is applied
-    params.callbacks.theme_changed = clear_with_window_bg
+    params.callbacks.setup_imgui_style = lambda: clear_with_window_bg()  # after the theme
+    params.callbacks.theme_changed = lambda: clear_with_window_bg()
     params.docking_params = _docking(viewer)
     params.ini_disable = True
     # Idle at a few fps when nothing moves (frees the CPU for offline jobs); the bench and the
