@@ -55,6 +55,7 @@ def _checked(function):
     return call
 
 
+glFlush = _checked(GL_1_0.glFlush)
 glEnable = _checked(GL_1_0.glEnable)
 glDisable = _checked(GL_1_0.glDisable)
 glClear = _checked(GL_1_0.glClear)

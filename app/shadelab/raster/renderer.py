@@ -394,6 +394,11 @@ class Renderer:
         # --- PASS 3: per light, a stencil count of its shadow volumes (z-fail or z-pass),
         #     then that light alone added where the count is 0 (S_i = 1), nowhere else
         if shadowed:
+            from shadelab.gl.lite import glFlush
+
+            # llvmpipe rasterizes pass 2 on its threads while this thread bins the volumes
+            # and the lit passes (else all of them wait for the display pass's flush)
+            glFlush()
             self._shadow_passes(scene, target, view, gpu_meshes, opaque, lights, shading,
                                 specular)
         # --- PASS 4: transparent surfaces back to front, blended by their model
