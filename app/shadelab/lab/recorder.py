@@ -97,6 +97,8 @@ class FrameRecorder:
         """After the frame is on screen: its time, CPU time and whether it re-rendered the
         scene. The first frame counts once the viewport has drawn (the very first frames
         only lay out the dock space and show no scene). True on that first frame."""
+        if self.breakdown and self._open:   # the GUI's draw and swap end here, inside the frame
+            self.end(self._open[0][0])
         now = time.perf_counter()
         first = not self.first_frame and self.viewport_shown
         if first:
@@ -108,8 +110,6 @@ class FrameRecorder:
         self.redraw_flags.append(flag)
         self.redrawn = False
         if self.breakdown:
-            if self._open:           # the GUI's draw and swap end here
-                self.end(self._open[0][0])
             self.part_cpu.append(self._cpu)
             self.part_wall.append(self._wall)
             self._cpu, self._wall = {}, {}
