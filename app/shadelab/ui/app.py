@@ -48,9 +48,12 @@ from shadelab.ui.viewport_reads import update_probe, write_viewport_screenshot
 
 
 class LazyPanels:
-    """A panel module imported when one of its windows first draws, not at start-up: the
+    """A panel module imported when one of its windows first draws after start-up: the
     windows behind a tab (Exercise, Studies, Algorithms, Ray tree) and what they import
-    (exercises, studies, the ray tree's layout) stay off the path to the first frame."""
+    (exercises, studies, the ray tree's layout) stay off the path to the first frame. (The
+    first frames, before the dock layout applies, draw every window: those draw nothing.)"""
+
+    FIRST_FRAMES = 2
 
     def __init__(self, module: str):
         self.module = f"shadelab.ui.{module}"
@@ -60,7 +63,10 @@ class LazyPanels:
 
         def draw(state: AppState) -> bool:
             import importlib
+            import sys
 
+            if module not in sys.modules and state.frame < LazyPanels.FIRST_FRAMES:
+                return False
             return getattr(importlib.import_module(module), name)(state)
 
         draw.__name__ = draw.__qualname__ = name
