@@ -8,6 +8,20 @@ uniform float u_diff_scale;     // heat map: this difference (after exposure) is
 uniform int u_tonemap;          // 0: clamp to [0, 1], 1: Reinhard x / (1 + x)
 uniform int u_clipping;         // 1: stripe the pixels clamping cuts (a channel above 1)
 
+// The viewer compiles one variant per (mode, tone map, clipping), DISPLAY_MODE, DISPLAY_TONEMAP
+// and DISPLAY_CLIPPING defined: llvmpipe runs every branch of a fragment under masks (the heat
+// map, Reinhard and the stripes cost each pixel as much again as the tone map it uses).
+// Without the defines the uniforms decide.
+#ifdef DISPLAY_MODE
+#define MODE DISPLAY_MODE
+#define TONEMAP DISPLAY_TONEMAP
+#define CLIPPING DISPLAY_CLIPPING
+#else
+#define MODE u_mode
+#define TONEMAP u_tonemap
+#define CLIPPING u_clipping
+#endif
+
 in vec2 v_uv;
 out vec4 f_color;
 
@@ -29,14 +43,14 @@ vec3 heat(float t) {
 
 void main() {
     vec3 a = texture(t_image, v_uv).rgb * u_exposure;
-    if (u_mode == 1) {
+    if (MODE == 1) {
         vec3 b = texture(t_other, v_uv).rgb * u_exposure;
         vec3 d = abs(a - b);
         f_color = vec4(heat(max(d.r, max(d.g, d.b)) / max(u_diff_scale, 1e-12)), 1.0);
     } else {
-        vec3 mapped = u_tonemap == 1 ? a / (1.0 + a) : a;
+        vec3 mapped = TONEMAP == 1 ? a / (1.0 + a) : a;
         vec3 rgb = to_srgb(mapped);
-        if (u_clipping == 1 && u_tonemap == 0 && max(a.r, max(a.g, a.b)) > 1.0) {
+        if (CLIPPING == 1 && TONEMAP == 0 && max(a.r, max(a.g, a.b)) > 1.0) {
             // magenta / black diagonal stripes, 8 pixels apart: readable from the back row
             float stripe = mod(floor((gl_FragCoord.x + gl_FragCoord.y) / 4.0), 2.0);
             rgb = stripe < 1.0 ? vec3(1.0, 0.0, 1.0) : vec3(0.0);

@@ -118,3 +118,19 @@ def test_ctrl_c_inside_a_numba_kernel_is_an_interrupt(monkeypatch, capsys, kind,
         return
     assert main(["presets"]) == code
     assert capsys.readouterr().err == "shadelab: interrupted\n"
+
+
+def test_the_command_table_names_every_subcommand_of_the_parser():
+    """main() imports only the module of the command asked for (cli.COMMANDS): the table
+    must name each subcommand the modules add, and each command's own parser is the same."""
+    from shadelab import cli
+
+    full = cli.build_parser()
+    choices = full._subparsers._group_actions[0].choices  # noqa: SLF001
+    assert set(choices) == set(cli.COMMANDS)
+    assert set(cli.COMMANDS.values()) == set(cli.COMMAND_MODULES)
+    for command in cli.COMMANDS:
+        one = cli.build_parser(command)
+        own = one._subparsers._group_actions[0].choices  # noqa: SLF001
+        assert command in own
+        assert own[command].format_help() == choices[command].format_help()

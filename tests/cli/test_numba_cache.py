@@ -135,3 +135,15 @@ def test_the_tests_own_cache_is_not_the_users(name):
     config = sys.modules.get(name)
     if config is not None:
         assert "shadelab-test-numba" in config.CACHE_DIR
+
+
+def test_dist_version_reads_what_importlib_metadata_reads():
+    """The kernel cache's stamp and the mesh cache's key read package versions without
+    importing importlib.metadata (a slow import on the viewer's way to its first frame)."""
+    from importlib.metadata import version
+
+    from shadelab.distributions import dist_version
+
+    for name in ("numba", "trimesh", "numpy", "moderngl"):
+        assert dist_version(name) == version(name), name
+    assert dist_version("no_such_package_shadelab") is None

@@ -101,7 +101,8 @@ def _all_rows(progresses) -> dict:
 
 def test_the_rows_sent_are_the_rows_the_solver_shot_with():
     """Every shooter's row arrives in ``ff_rows`` (sent once), equal to the row of the
-    reciprocal matrix the form-factor engine computes (the one every solver reads); a second job on the same geometry sends every known row
+    reciprocal matrix the form-factor engine computes (the one every solver reads); a second
+    job on the same geometry sends every known row
     in its first Progress (the window may have missed none)."""
     scene = _cornell(tolerance=0.05)
     pipeline._RADIOSITY_CACHE.clear()

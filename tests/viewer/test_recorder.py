@@ -57,3 +57,63 @@ def test_report_has_the_figures_of_each_phase_after_its_warm_up(tmp_path):
     assert report["redraw_frame_ms_median"] == pytest.approx(30.0)
     assert "interactive_frame_ms_median" not in report
     assert report["jobs"] == [] and "first_frame_s" in report
+
+
+def test_breakdown_parts_are_non_negative_and_sum_to_at_most_the_frame(tmp_path):
+    """The bench's breakdown of a frame: each part's main-thread CPU time, a nested part taken
+    out of the one around it, and the rest of the frame's process CPU time as other_cpu_ms;
+    parts are disjoint intervals of the frame, so they never sum to more than it."""
+    import time
+
+    from shadelab.lab.recorder import PARTS
+
+    def burn(seconds: float) -> None:
+        end = time.thread_time() + seconds
+        while time.thread_time() < end:
+            pass
+
+    rec = FrameRecorder(viewport_shown=True, breakdown=True)
+    rec.frame_swapped()
+    n = WARM_UP_FRAMES + 6
+    for frame in range(2 * n):
+        redraw = frame >= n
+        rec.begin("gui")
+        burn(0.002)
+        if redraw:
+            with rec.part("scene"):
+                burn(0.003)
+                with rec.part("readback"):
+                    burn(0.001)
+        rec.end("gui")
+        rec.begin("gui_render")
+        burn(0.001)
+        rec.redrawn = redraw
+        rec.frame_swapped()   # closes gui_render
+    assert len(rec.part_cpu) == len(rec.frame_times) and rec._open == []
+    report = rec.report((1280, 720))
+    for phase in ("idle", "redraw"):
+        parts = report[f"{phase}_breakdown"]
+        assert set(parts["cpu_ms"]) == set(PARTS) == set(parts["wall_ms"])
+        assert all(v >= 0.0 for v in parts["cpu_ms"].values())
+        assert all(v >= 0.0 for v in parts["wall_ms"].values())
+        assert parts["other_cpu_ms"] >= 0.0
+        frame_cpu = parts["frame_cpu_ms"]
+        assert sum(parts["cpu_ms"].values()) <= frame_cpu * 1.05 + 0.5
+        assert sum(parts["wall_ms"].values()) <= parts["frame_wall_ms"] * 1.05 + 0.5
+        assert parts["parts_over_frame_cpu_max"] <= 1.0 + 1e-6
+        assert parts["frames"] == n - WARM_UP_FRAMES
+    idle, redraw = report["idle_breakdown"]["cpu_ms"], report["redraw_breakdown"]["cpu_ms"]
+    assert idle["scene"] == 0.0 and idle["readback"] == 0.0
+    # nested parts are exclusive: gui ~2 ms, scene ~3 ms, readback ~1 ms, gui_render ~1 ms
+    assert redraw["gui"] == pytest.approx(2.0, abs=1.0)
+    assert redraw["scene"] == pytest.approx(3.0, abs=1.0)
+    assert redraw["readback"] == pytest.approx(1.0, abs=0.7)
+    assert redraw["gui_render"] == pytest.approx(1.0, abs=0.7)
+
+
+def test_breakdown_is_off_outside_the_bench():
+    rec = FrameRecorder(viewport_shown=True)
+    rec.begin("gui")
+    rec.end("gui")
+    rec.frame_swapped()
+    assert rec.part_cpu == [] and "idle_breakdown" not in rec.report((640, 480))

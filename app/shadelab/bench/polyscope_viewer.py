@@ -1,6 +1,7 @@
 """The bench's peer: Polyscope drawing the same triangles in the same window size.
 
-Run as ``python -m shadelab.bench.polyscope_viewer PRESET WxH FRAMES OUT.json`` (by
+Run as ``python -m shadelab.bench.polyscope_viewer PRESET WxH FRAMES OUT.json [KEY=VALUE...]``
+(the preset's ``--set`` overrides; by
 :mod:`shadelab.bench.viewer`, on the display the viewer used). Every frame is redrawn
 (``set_always_redraw``), vsync off and no frame cap, so the figure is Polyscope's full
 redraw rate; ``first_frame_s`` counts from process start, imports included, as the viewer's.
@@ -38,14 +39,14 @@ def _version() -> str | None:
 
 
 def main(argv: list[str]) -> int:
-    preset, window, frames, out = argv[0], argv[1], int(argv[2]), argv[3]
+    preset, window, frames, out, overrides = argv[0], argv[1], int(argv[2]), argv[3], argv[4:]
     import numpy as np
     import polyscope as ps
 
     from shadelab.geometry.mesh import scene_meshes
     from shadelab.scene.preset import load_preset
 
-    meshes = scene_meshes(load_preset(preset))
+    meshes = scene_meshes(load_preset(preset, overrides))
     width, height = (int(v) for v in window.split("x"))
     ps.set_program_name("shadelab bench: polyscope")
     ps.set_window_size(width, height)
@@ -55,18 +56,20 @@ def main(argv: list[str]) -> int:
     ps.init()
     for mesh in meshes:
         ps.register_surface_mesh(f"object{mesh.index}", mesh.vertices, mesh.faces)
-    times = []
+    times, cpu = [], []
     first = None
     for _ in range(frames):
         ps.frame_tick()
         times.append(time.perf_counter())
+        cpu.append(time.process_time())
         if first is None:
             first = since_process_start()
     ms = np.diff(np.asarray(times))[WARMUP:] * 1000.0
+    cpu_ms = np.diff(np.asarray(cpu))[WARMUP:] * 1000.0
     report = {"frames": frames, "window": window, "triangles": int(sum(len(m.faces)
                                                                        for m in meshes)),
-              "frame_ms_median": float(np.median(ms)), "first_frame_s": first,
-              "version": _version()}
+              "frame_ms_median": float(np.median(ms)), "cpu_ms_median": float(np.median(cpu_ms)),
+              "first_frame_s": first, "version": _version()}
     Path(out).write_text(json.dumps(report), encoding="utf-8")
     return 0
 

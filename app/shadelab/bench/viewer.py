@@ -1,6 +1,13 @@
-"""Viewer speed: frame time with the GUI drawn (1280x720, cornell, one light) and the time
-from process start to the first frame. The viewer runs in a subprocess (under ``xvfb-run``
-when there is no display); without a display or Xvfb the section is skipped with a note.
+"""Viewer speed against Polyscope, case by case: cornell and the lecture scene, at 1280x720 and
+at 1024x768 in presenter mode, each the viewer then Polyscope on the same triangles, window
+size and display (alternated, so both see the same machine load); a frame's CPU time broken
+into its parts; idle frames of a small and an 80k-triangle scene; and the time from process
+start to the first frame on a warm cache.
+
+The viewer runs in subprocesses (under ``xvfb-run`` when there is no display); without a
+display or Xvfb the section is skipped with a note. A warm cache: one unmeasured start first,
+with Python's bytecode written (``PYTHONDONTWRITEBYTECODE`` set: into ShadeLab's cache folder
+by ``PYTHONPYCACHEPREFIX``), as an installed ShadeLab has it.
 """
 
 from __future__ import annotations
@@ -16,29 +23,53 @@ import tempfile
 import time
 from pathlib import Path
 
-WINDOW = "1280x720"
-NOTE = ("frame_ms: the scene re-rendered every frame at full resolution with every panel drawn; "
+# (preset, window, presenter, overrides): the redraw cases compared with Polyscope
+CASES = (("cornell", "1280x720", False, ()), ("lecture", "1280x720", False, ()),
+         ("cornell", "1024x768", True, ()), ("lecture", "1024x768", True, ()))
+# idle frames against scene size: the same window, cornell's 38 triangles against 81,920
+MESH80K = ("sphere-shading", "1280x720", False, ("objects.0.subdivisions=6",))
+FIRST_FRAME_CASE = "cornell_1280x720"   # the goal's first_frame_s
+DISPLAY = "1344x800x24"                 # one Xvfb screen that holds every case's window
+NOTE = ("cases: each case runs the viewer, then Polyscope, on one display; frame_ms: the scene "
+        "re-rendered every frame at full resolution with every panel drawn; "
         "interactive_frame_ms: the same at the drag-time render scale (0.5, what a slider or "
-        "camera drag gets); idle_frame_ms: nothing changed, the GUI alone; first frame counted "
-        "from process start (imports included); cpu_ms: this process's CPU time per frame "
-        "(llvmpipe threads included), steadier than wall time on a shared machine; polyscope: the "
-        "same cornell triangles, window and display, every frame redrawn, vsync off; "
-        "fps_over_polyscope = fps / polyscope fps (both redraw every frame), "
-        "idle_fps_over_polyscope = idle_fps / polyscope fps (the cached viewport image)")
+        "camera drag gets); idle_frame_ms: nothing changed (the cached viewport image), the GUI "
+        "alone; cpu_ms: the process's CPU time per frame (llvmpipe threads included), steadier "
+        "than wall time on a shared machine; breakdown: the main thread's CPU ms in each part of "
+        "a frame (gui: panels built; scene: the viewport's passes; gpu_requests: renders and "
+        "read-backs panels queued; readback: probe and screenshot; gui_render: ImGui's GL draw "
+        "and the swap) and other_cpu_ms, the rest of the frame's process CPU (the GL driver's "
+        "threads: llvmpipe rasterizes there); scene_cpu_ms = redraw cpu - idle cpu; polyscope: "
+        "the same triangles, window and display, every frame redrawn, vsync off; "
+        "fps_over_polyscope = fps / polyscope fps (both redraw every frame), cpu_over_polyscope = "
+        "polyscope's CPU ms per frame / ours; first_frame_s: "
+        "from process start (imports included), after one unmeasured start (warm caches); "
+        "first_frame_cpu_s: the process's CPU seconds until then (steadier under load)")
 
 
-def viewer_command(frames: int, json_path: str) -> list[str]:
+def case_name(preset: str, window: str, presenter: bool, overrides=()) -> str:
+    name = "mesh80k" if overrides else preset
+    return f"{name}_{window}" + ("_presenter" if presenter else "")
+
+
+def viewer_command(frames: int, json_path: str, preset: str = "cornell",
+                   window: str = "1280x720", presenter: bool = False,
+                   overrides=()) -> list[str]:
     """The command that runs the viewer for ``frames`` frames."""
-    return [sys.executable, "-m", "shadelab", "view", "cornell", "--fresh", "--no-autosave",
-            "--window", WINDOW, "--frames", str(frames), "--bench-json", json_path]
+    command = [sys.executable, "-m", "shadelab", "view", preset, "--fresh", "--no-autosave",
+               "--window", window, "--frames", str(frames), "--bench-json", json_path]
+    for value in overrides:
+        command += ["--set", value]
+    return command + (["--presenter"] if presenter else [])
 
 
-def polyscope_command(frames: int, json_path: str) -> list[str] | None:
+def polyscope_command(frames: int, json_path: str, preset: str = "cornell",
+                      window: str = "1280x720", overrides=()) -> list[str] | None:
     """Polyscope on the same triangles and window (None where it is not installed)."""
     if importlib.util.find_spec("polyscope") is None:
         return None
-    return [sys.executable, "-m", "shadelab.bench.polyscope_viewer", "cornell", WINDOW, str(frames),
-            json_path]
+    return [sys.executable, "-m", "shadelab.bench.polyscope_viewer", preset, window, str(frames),
+            json_path, *overrides]
 
 
 def on_display(commands: list[list[str]]) -> list[str] | None:
@@ -49,51 +80,156 @@ def on_display(commands: list[list[str]]) -> list[str] | None:
         return ["sh", "-c", script]
     if shutil.which("xvfb-run") is None:
         return None
-    return ["xvfb-run", "-a", "-s", "-screen 0 1344x784x24", "sh", "-c", script]
+    return ["xvfb-run", "-a", "-s", f"-screen 0 {DISPLAY}", "sh", "-c", script]
+
+
+def warm_environment(folder: str) -> tuple[dict, str]:
+    """The subprocesses' environment and where their bytecode is cached: Python's own
+    ``__pycache__`` folders, or (``PYTHONDONTWRITEBYTECODE`` set) ShadeLab's cache folder."""
+    # no background `shadelab warm` compiling kernels beside the measured frames (a cold
+    # kernel cache is reported as kernel_cache_warm false; `shadelab warm` warms it)
+    env = dict(os.environ, XDG_STATE_HOME=folder, SHADELAB_AUTOWARM="0",
+               PYTHONPATH=str(Path(__file__).resolve().parents[2]))
+    env.pop("PYOPENGL_PLATFORM", None)  # the viewer is GLX, never EGL
+    bytecode = "__pycache__ (Python's default)"
+    if env.pop("PYTHONDONTWRITEBYTECODE", None) and not env.get("PYTHONPYCACHEPREFIX"):
+        from shadelab.paths import user_cache_root
+
+        env["PYTHONPYCACHEPREFIX"] = str(user_cache_root() / "pycache")
+    if env.get("PYTHONPYCACHEPREFIX"):
+        bytecode = env["PYTHONPYCACHEPREFIX"]
+    return env, bytecode
+
+
+def _read(path: Path) -> dict | None:
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
 
 
 def run(quick: bool) -> dict:
     frames = 90 if quick else 300
     with tempfile.TemporaryDirectory() as folder:
-        json_path = str(Path(folder) / "viewer.json")
-        peer_path = str(Path(folder) / "polyscope.json")
-        peer = polyscope_command(frames, peer_path)
-        command = on_display([viewer_command(frames, json_path)] + ([peer] if peer else []))
+        env, bytecode = warm_environment(folder)
+        out = Path(folder)
+        commands = [viewer_command(3, str(out / "warm.json"))]  # warm caches: not measured
+        peer_warm = polyscope_command(3, str(out / "warm-peer.json"))
+        commands += [peer_warm] if peer_warm else []
+        runs = []
+        for preset, window, presenter, overrides in (*CASES, MESH80K):
+            name = case_name(preset, window, presenter, overrides)
+            viewer_json, peer_json = out / f"{name}.json", out / f"{name}-polyscope.json"
+            commands.append(viewer_command(frames, str(viewer_json), preset, window, presenter,
+                                           overrides))
+            peer = None if overrides else polyscope_command(frames, str(peer_json), preset,
+                                                            window, overrides)
+            commands += [peer] if peer else []
+            runs.append((name, preset, window, presenter, overrides, viewer_json,
+                         peer_json if peer else None))
+        command = on_display(commands)
         if command is None:
             return {"skipped": "no DISPLAY and no xvfb-run (apt-get install xvfb)"}
-        env = dict(os.environ, XDG_STATE_HOME=folder,
-                   PYTHONPATH=str(Path(__file__).resolve().parents[2]))
-        env.pop("PYOPENGL_PLATFORM", None)  # the viewer is GLX, never EGL
         start = time.perf_counter()
-        proc = subprocess.run(command, env=env, capture_output=True, text=True, timeout=600)
+        proc = subprocess.run(command, env=env, capture_output=True, text=True,
+                              timeout=300 + 60 * len(commands) * frames // 90)
         wall = time.perf_counter() - start
-        if not Path(json_path).is_file():
-            tail = (proc.stderr or proc.stdout).strip().splitlines()[-3:]
-            return {"skipped": f"viewer failed (exit {proc.returncode}): {' | '.join(tail)}"}
-        report = json.loads(Path(json_path).read_text(encoding="utf-8"))
-        polyscope = (json.loads(Path(peer_path).read_text(encoding="utf-8"))
-                     if Path(peer_path).is_file() else None)
+        cases, idle = {}, {}
+        for name, preset, window, presenter, overrides, viewer_json, peer_json in runs:
+            report = _read(viewer_json)
+            if report is None:
+                tail = (proc.stderr or proc.stdout).strip().splitlines()[-3:]
+                figures = {"error": f"viewer failed (exit {proc.returncode}): "
+                                    f"{' | '.join(tail)}"}
+            else:
+                figures = case_figures(report)
+            figures.update(preset=preset, window=window, presenter=presenter)
+            if overrides:
+                figures["overrides"] = list(overrides)
+                idle[name] = figures
+                continue
+            peer = None if peer_json is None else _read(peer_json)
+            figures.update(peer_figures(peer, figures.get("fps"),
+                                        figures.get("idle_frame_ms_median"),
+                                        None if peer_json is None else ["polyscope"],
+                                        figures.get("frame_cpu_ms_median")))
+            cases[name] = figures
+    if all("error" in c for c in cases.values()):
+        return {"skipped": next(iter(cases.values()))["error"], "cases": cases}
+    return summary(cases, idle, frames, wall, bytecode)
+
+
+def case_figures(report: dict) -> dict:
+    """One viewer run's figures (``--bench-json``): redraw, interactive and idle frames, their
+    CPU time and its breakdown, the first frame."""
     redraw = report.get("redraw_frame_ms_median")
     idle = report.get("idle_frame_ms_median")
-    fps = 1000.0 / redraw if redraw else None
-    return {"window": WINDOW, "preset": "cornell", "lights": 1, "frames": report["frames"],
-            "frame_ms_median": redraw, "frame_ms_max": report.get("redraw_frame_ms_max"),
-            "fps": fps, "frame_cpu_ms_median": report.get("redraw_cpu_ms_median"),
-            "interactive_frame_ms_median": report.get("interactive_frame_ms_median"),
-            "interactive_cpu_ms_median": report.get("interactive_cpu_ms_median"),
-            "interactive_fps": (1000.0 / report["interactive_frame_ms_median"]
-                                if report.get("interactive_frame_ms_median") else None),
-            "idle_frame_ms_median": idle,
-            "idle_cpu_ms_median": report.get("idle_cpu_ms_median"),
-            "idle_fps": 1000.0 / idle if idle else None,
-            "first_frame_s": report["first_frame_s"], "process_wall_s": wall,
-            "note": NOTE, "load_average": os.getloadavg()[0], **peer_figures(polyscope, fps,
-                                                                              idle, peer)}
+    interactive = report.get("interactive_frame_ms_median")
+    out = {"frames": report.get("frames"), "triangles": report.get("triangles"),
+           "frame_ms_median": redraw, "frame_ms_max": report.get("redraw_frame_ms_max"),
+           "fps": 1000.0 / redraw if redraw else None,
+           "frame_cpu_ms_median": report.get("redraw_cpu_ms_median"),
+           "interactive_frame_ms_median": interactive,
+           "interactive_cpu_ms_median": report.get("interactive_cpu_ms_median"),
+           "interactive_fps": 1000.0 / interactive if interactive else None,
+           "idle_frame_ms_median": idle, "idle_cpu_ms_median": report.get("idle_cpu_ms_median"),
+           "idle_fps": 1000.0 / idle if idle else None,
+           "first_frame_s": report.get("first_frame_s"),
+           "first_frame_cpu_s": report.get("first_frame_cpu_s"),
+           "breakdown": {phase: report[f"{phase}_breakdown"]
+                         for phase in ("redraw", "interactive", "idle")
+                         if f"{phase}_breakdown" in report}}
+    if report.get("redraw_cpu_ms_median") is not None and \
+            report.get("idle_cpu_ms_median") is not None:
+        out["scene_cpu_ms"] = report["redraw_cpu_ms_median"] - report["idle_cpu_ms_median"]
+    return out
+
+
+def summary(cases: dict, idle: dict, frames: int, wall: float, bytecode: str) -> dict:
+    """The section: every case, the cornell 1280x720 figures at the top (the first frame's
+    goal reads them), the worst case's ratio, idle CPU against scene size."""
+    ratios = {name: c.get("fps_over_polyscope") for name, c in cases.items()}
+    measured = [r for r in ratios.values() if isinstance(r, (int, float))]
+    first = cases.get(FIRST_FRAME_CASE, {})
+    out = {"frames": frames, "cases": cases,
+           "fps_over_polyscope_min": min(measured) if measured else None,
+           "first_frame_s": first.get("first_frame_s"),
+           "first_frame_cpu_s": first.get("first_frame_cpu_s"),
+           "first_frame_s_max": max((c["first_frame_s"] for c in cases.values()
+                                     if c.get("first_frame_s") is not None), default=None),
+           "bytecode_cache": bytecode, "kernel_cache_warm": kernel_cache_warm(),
+           "process_wall_s": wall,
+           "load_average": os.getloadavg()[0], "note": NOTE}
+    for key in ("window", "preset", "fps", "frame_ms_median", "frame_cpu_ms_median",
+                "idle_frame_ms_median", "idle_cpu_ms_median", "fps_over_polyscope"):
+        out[key] = first.get(key)
+    big = next(iter(idle.values()), {})
+    small_cpu, big_cpu = first.get("idle_cpu_ms_median"), big.get("idle_cpu_ms_median")
+    out["idle_vs_scene_size"] = {
+        "cornell": {"triangles": first.get("triangles"), "idle_cpu_ms": small_cpu,
+                    "idle_frame_ms": first.get("idle_frame_ms_median")},
+        "mesh80k": {"triangles": big.get("triangles"), "idle_cpu_ms": big_cpu,
+                    "idle_frame_ms": big.get("idle_frame_ms_median"),
+                    "redraw_cpu_ms": big.get("frame_cpu_ms_median"),
+                    **({"error": big["error"]} if "error" in big else {})},
+        "idle_cpu_mesh80k_over_cornell": (big_cpu / small_cpu
+                                          if small_cpu and big_cpu else None)}
+    return out
+
+
+def kernel_cache_warm() -> bool | None:
+    """Whether ``shadelab warm`` has filled the numba kernel cache (None: no cache folder)."""
+    from shadelab.cli.warm import done_mark
+
+    mark = done_mark()
+    return None if mark is None else mark.exists()
 
 
 def peer_figures(polyscope: dict | None, fps: float | None, idle_ms: float | None,
-                 command: list[str] | None) -> dict:
-    """Polyscope's figures beside the viewer's, or why there are none."""
+                 command: list[str] | None, cpu_ms: float | None = None) -> dict:
+    """Polyscope's figures beside the viewer's, or why there are none; ``cpu_over_polyscope``:
+    Polyscope's CPU ms per redrawn frame over ours (the same comparison in CPU time, which a
+    shared machine's load disturbs less than wall time)."""
     if command is None:
         from shadelab.bench.goals import INSTALL_PEERS
 
@@ -101,9 +237,12 @@ def peer_figures(polyscope: dict | None, fps: float | None, idle_ms: float | Non
     if polyscope is None:
         return {"polyscope": "failed (no report written)"}
     peer_fps = 1000.0 / polyscope["frame_ms_median"]
+    peer_cpu = polyscope.get("cpu_ms_median")
     return {"polyscope": {**polyscope, "fps": peer_fps},
             "fps_over_polyscope": fps / peer_fps if fps else None,
+            "cpu_over_polyscope": peer_cpu / cpu_ms if peer_cpu and cpu_ms else None,
             "idle_fps_over_polyscope": 1000.0 / idle_ms / peer_fps if idle_ms else None}
+
 
 if __name__ == "__main__":
     print(json.dumps(run("--quick" in sys.argv), indent=2))

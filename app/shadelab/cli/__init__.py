@@ -31,6 +31,16 @@ COMMAND_MODULES = (
     "shadelab.cli.exercise",
 )
 
+# Each subcommand's module: a run imports only the module of the command it names (the viewer's
+# start skips the others' imports); help and unknown words get the whole parser.
+COMMANDS = {"render": "shadelab.cli.render", "presets": "shadelab.cli.render",
+            "validate": "shadelab.cli.render", "raytrace": "shadelab.cli.raytrace",
+            "pathtrace": "shadelab.cli.raytrace", "radiosity": "shadelab.cli.radiosity",
+            "charts": "shadelab.cli.studies", "gallery": "shadelab.cli.studies",
+            "bench": "shadelab.cli.bench", "view": "shadelab.cli.view",
+            "warm": "shadelab.cli.warm", "sweep": "shadelab.cli.sweep",
+            "exercise": "shadelab.cli.exercise"}
+
 EXIT_BAD_INPUT = 2
 EXIT_IO_ERROR = 1      # an output could not be written
 
@@ -42,7 +52,8 @@ class _Parser(argparse.ArgumentParser):
         raise ShadeLabError(f"{self.prog}: {message}")
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The ``shadelab`` parser: every subcommand, or only ``command``'s module's."""
     parser = _Parser(prog="shadelab",
                      description="ShadeLab: an interactive lab for illumination and shading. "
                                  "Run 'shadelab [PRESET]' to open the viewer (default: lecture).")
@@ -51,7 +62,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"shadelab {__version__}")
     parser.add_argument(*QUIET_FLAGS, action="store_true", help=QUIET_HELP)
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
-    for name in COMMAND_MODULES:
+    for name in (COMMAND_MODULES if command not in COMMANDS else (COMMANDS[command],)):
         importlib.import_module(name).add_parser(sub)
     for command in sub.choices.values():  # global: before or after the subcommand
         command.add_argument(*QUIET_FLAGS, action="store_true", default=argparse.SUPPRESS,
@@ -93,12 +104,11 @@ def _interactive(stream) -> bool:
 
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
-    parser = build_parser()
-    commands = set(parser._subparsers._group_actions[0].choices)  # noqa: SLF001
     lead = argv[:1] if argv[:1] and argv[0] in QUIET_FLAGS else []  # 'shadelab -q render'
     rest = argv[len(lead):]
-    if not rest or (rest[0] not in commands and rest[0] not in ("-h", "--help", "--version")):
+    if not rest or (rest[0] not in COMMANDS and rest[0] not in ("-h", "--help", "--version")):
         argv = [*lead, "view", *rest]  # 'shadelab [PRESET] [view options]' opens the viewer
+    parser = build_parser(argv[len(lead)])
     saved_allow = os.environ.get(ALLOW_ENV)
     saved_term = None
     from shadelab import progress

@@ -78,14 +78,10 @@ def _warm_scenes():
 
 
 def _stamp() -> str:
-    from importlib.metadata import PackageNotFoundError, version
-
+    from shadelab.distributions import dist_version  # not importlib.metadata: a slow import
     from shadelab.version import __version__
 
-    try:
-        numba = version("numba")
-    except PackageNotFoundError:  # pragma: no cover - numba is a dependency
-        numba = "unknown"
+    numba = dist_version("numba") or "unknown"
     return f"{__version__}-numba{numba}-py{sys.version_info[0]}{sys.version_info[1]}"
 
 

@@ -45,12 +45,9 @@ def cache_dir() -> Path | None:
 
 @lru_cache(maxsize=1)
 def _trimesh_version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
+    from shadelab.distributions import dist_version  # not importlib.metadata: a slow import
 
-    try:
-        return version("trimesh")
-    except PackageNotFoundError:  # pragma: no cover - trimesh is a dependency
-        return "unknown"
+    return dist_version("trimesh") or "unknown"
 
 
 def key(kind: str, *parts) -> str:

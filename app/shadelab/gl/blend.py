@@ -16,7 +16,7 @@ GL_ONE_MINUS_CONSTANT_ALPHA = 0x8004
 
 def set_blend(ctx: moderngl.Context, material) -> None:
     """Blend state for one material: off when opaque, else the material's model."""
-    from OpenGL import GL  # imported late: the context module picks PyOpenGL's platform
+    from shadelab.gl import lite as GL  # late: the context module picks PyOpenGL's platform
 
     if material.kt <= 0.0:
         ctx.disable(moderngl.BLEND)
@@ -34,7 +34,7 @@ def set_blend(ctx: moderngl.Context, material) -> None:
 
 def restore_blend(ctx: moderngl.Context) -> None:
     """Back to moderngl's default blending (and a zero constant color)."""
-    from OpenGL import GL
+    from shadelab.gl import lite as GL
 
     _ = ctx.error
     GL.glBlendColor(0.0, 0.0, 0.0, 0.0)

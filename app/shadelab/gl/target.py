@@ -12,9 +12,9 @@ import numpy as np
 
 
 def _gl():
-    from OpenGL import GL  # imported late: the context module picks PyOpenGL's platform
+    from shadelab.gl import lite  # imported late: the context module picks PyOpenGL's platform
 
-    return GL
+    return lite
 
 
 def _raw_gl():

@@ -14,6 +14,7 @@ import moderngl
 import numpy as np
 
 from shadelab.geometry.mesh import MeshData, geometry_key, object_mesh, scene_bounds
+from shadelab.gl import programs as gl_programs
 from shadelab.gl.programs import (
     UniformCache,
     load_program,
@@ -46,6 +47,31 @@ TEXTURED_PROGRAMS = {name: f"{name}_tex" for name in SHADING_PROGRAMS}
 # The programs whose Od is the material's u_Od: compiled with PREMULTIPLIED (lighting.glsl), so
 # the per-material, per-light factors are folded here once instead of read per fragment.
 PREMULTIPLIED = {"PREMULTIPLIED": 1}
+
+
+class ProgramVariant(dict):
+    """One light configuration's shading programs by name, each compiled on first use: a
+    frame draws with one or two of the six (its shading mode, and its textured twin where a
+    material has surface detail), and every compile costs start-up time on llvmpipe."""
+
+    def __init__(self, ctx: moderngl.Context, defines: dict[str, object]):
+        super().__init__()
+        self.ctx = ctx
+        self.defines = defines
+
+    def __missing__(self, name: str) -> moderngl.Program:
+        if name in TEXTURED_PROGRAMS.values():
+            program = load_program(self.ctx, name, self.defines)
+        elif name in SHADING_PROGRAMS:
+            # ShadeLab's lighting chunk: the plain programs premultiplied; a replaced chunk (a
+            # student's, registered by load_program as it compiles) reads its own uniforms
+            gl_programs.register_includes(self.ctx)
+            fast = PREMULTIPLIED if stock_include(self.ctx, "lighting") else {}
+            program = load_program(self.ctx, name, {**self.defines, **fast})
+        else:
+            raise KeyError(name)
+        self[name] = program
+        return program
 
 
 @dataclass
@@ -120,6 +146,7 @@ class Renderer:
         self._matrix: tuple[View, bytes] | None = None  # the last view's matrix, packed
         self._bounds: tuple | None = None  # (mesh ids, their union box, the meshes)
         self._batches: dict[tuple, GpuMesh] = {}  # runs of meshes of one material, merged
+        self._detail = False  # a material of the scene drawn has surface detail (render)
         self.light_signature: tuple = ((), "phong")
         self._variant_key: tuple = (self.light_signature, False)
         self.programs = self.programs_for_lights([], "phong")
@@ -147,8 +174,9 @@ class Renderer:
                 "SPECULAR_MODEL": SPECULAR_CODES[model]}
 
     def programs_for_lights(self, lights: list[Light], specular: str,
-                            terminator: bool = False) -> dict:
-        """Every shading program compiled for this light configuration (cached).
+                            terminator: bool = False) -> ProgramVariant:
+        """Every shading program for this light configuration (cached; each compiled on first
+        use, :class:`ProgramVariant`).
 
         Positions, colors and coefficients stay uniforms, so sliders never recompile; adding
         a light or changing a light's kind or attenuation mode compiles a new variant once.
@@ -164,14 +192,7 @@ class Renderer:
             defines = self.light_defines(signature)
             if terminator and _chunk_fades(self.ctx):
                 defines["TERMINATOR"] = 1
-            variant = {name: load_program(self.ctx, name, defines)
-                       for name in TEXTURED_PROGRAMS.values()}
-            # ShadeLab's lighting chunk: the plain programs premultiplied; a replaced chunk (a
-            # student's) reads its own uniforms as written
-            fast = PREMULTIPLIED if stock_include(self.ctx, "lighting") else {}
-            variant.update({name: load_program(self.ctx, name, {**defines, **fast})
-                            for name in SHADING_PROGRAMS})
-            self._variants[key] = variant
+            self._variants[key] = ProgramVariant(self.ctx, defines)
         return self._variants[key]
 
     def uniforms(self, program: moderngl.Program) -> ProgramUniforms:
@@ -223,8 +244,11 @@ class Renderer:
 
     # ------------------------------------------------------------ uniforms
     def variants(self, shading: str) -> list[moderngl.Program]:
-        """The shading mode's program and its surface-detail variant."""
-        return [self.programs[shading], self.programs[TEXTURED_PROGRAMS[shading]]]
+        """The shading mode's program and, where a material has surface detail, its textured
+        variant: the programs this frame's passes draw with."""
+        if self._detail:
+            return [self.programs[shading], self.programs[TEXTURED_PROGRAMS[shading]]]
+        return [self.programs[shading]]
 
     def program_for(self, shading: str, material: Material) -> str:
         """Name of the program that draws ``material`` in ``shading`` mode."""
@@ -346,6 +370,7 @@ class Renderer:
         specular = specular or scene.render.specular
         settings = scene.render
         gpu_meshes = self.sync(scene)
+        self._detail = any(has_surface_detail(m) for m in scene.materials.values())
         lights = scene.active_lights()[:MAX_LIGHTS]
         self.use_lights(lights, specular)
         painter = settings.visibility == "painter"
@@ -378,6 +403,11 @@ class Renderer:
         # --- PASS 3: per light, a stencil count of its shadow volumes (z-fail or z-pass),
         #     then that light alone added where the count is 0 (S_i = 1), nowhere else
         if shadowed:
+            from shadelab.gl.lite import glFlush
+
+            # llvmpipe rasterizes pass 2 on its threads while this thread bins the volumes
+            # and the lit passes (else all of them wait for the display pass's flush)
+            glFlush()
             self._shadow_passes(scene, target, view, gpu_meshes, opaque, lights, shading,
                                 specular)
         # --- PASS 4: transparent surfaces back to front, blended by their model

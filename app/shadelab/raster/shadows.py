@@ -50,9 +50,9 @@ def filter_bit(slot: int) -> int:
 
 
 def _gl():
-    from OpenGL import GL
+    from shadelab.gl import lite  # PyOpenGL's raw entry points, checked (gl/lite.py)
 
-    return GL
+    return lite
 
 
 def heat_color(count: int) -> tuple[float, float, float, float]:

@@ -41,22 +41,50 @@ from shadelab.ui import (
     pipelines,
     presenter,
     radiosity_view,
-    ray_tree_panel,
     scene_labels,
     scene_panel,
     stage,
 )
-from shadelab.ui.exercise_panel import draw_exercise_panel
 from shadelab.ui.followups import FollowUps, ViewerOptions, write_window_screenshot
 from shadelab.ui.frame import guarded
 from shadelab.ui.offline import draw_offline_panel
-from shadelab.ui.render_panel import draw_algorithms_panel
-from shadelab.ui.studies_panel import draw_gallery_panel, draw_studies_panel
 from shadelab.ui.viewport_reads import update_probe, write_viewport_screenshot
+
+
+class LazyPanels:
+    """A panel module imported when one of its windows first draws after start-up: the
+    windows behind a tab (Exercise, Studies, Algorithms, Ray tree) and what they import
+    (exercises, studies, the ray tree's layout) stay off the path to the first frame. (The
+    first frames, before the dock layout applies, draw every window: those draw nothing.)"""
+
+    FIRST_FRAMES = 2
+
+    def __init__(self, module: str):
+        self.module = f"shadelab.ui.{module}"
+
+    def __getattr__(self, name: str) -> Callable:
+        module = self.module
+
+        def draw(state: AppState) -> bool:
+            import importlib
+            import sys
+
+            if module not in sys.modules and state.frame < LazyPanels.FIRST_FRAMES:
+                return False
+            return getattr(importlib.import_module(module), name)(state)
+
+        draw.__name__ = draw.__qualname__ = name
+        return draw
+
+
+exercise_panel = LazyPanels("exercise_panel")
+render_panel = LazyPanels("render_panel")
+studies_panel = LazyPanels("studies_panel")
+ray_tree_panel = LazyPanels("ray_tree_panel")
 
 PRESENTER_SCALE = 1.8      # font scale of presenter mode
 WARM_JOBS_AT_FRAME = 60    # start the offline-job process once the window is up
-WINDOW_BG = imgui.ImVec4(0.06, 0.06, 0.06, 1.0)  # the dark theme's panel color, opaque
+WINDOW_BG = imgui.ImVec4(0.06, 0.06, 0.06, 1.0)  # the window's clear before the theme's is known
 
 
 # ---------------------------------------------------------------- shortcuts
@@ -173,6 +201,7 @@ class Viewer:
 
     def __post_init__(self) -> None:
         self.followups = FollowUps(self.options)
+        self.recorder.breakdown = bool(self.options.bench_json)  # the frame's parts, timed
 
     # ------------------------------------------------------------ GL lifetime
     def post_init(self) -> None:
@@ -207,13 +236,21 @@ class Viewer:
         if self.options.bench_json:
             self.recorder.write(self.options.bench_json, self.options.window_size,
                                 pipelines.bench_report(self.state)  # jobs: first_image_s...
-                                | self.followups.bench_extra())
+                                | self.followups.bench_extra()
+                                | {"triangles": self.triangles()})
         if self.gpu is not None:
             self.gpu.release()
             self.gpu = None
         if self.viewport is not None:
             self.viewport.release()
             self.viewport = None
+
+    def triangles(self) -> int | None:
+        """The scene's triangle count (the bench's report), None when a mesh does not load."""
+        try:
+            return sum(len(m.faces) for m in scene_meshes(self.state.scene))
+        except Exception:  # a broken edit: the report is still written
+            return None
 
     # ------------------------------------------------------------ viewport window
     def draw_viewport_window(self) -> None:
@@ -232,7 +269,8 @@ class Viewer:
             state.walk.next_size = (size[0], max(int(avail.y - presenter.next_step_band(
                 state, avail.x) - strip) - 4, 16))
         if state.view.compare:
-            compare_view.draw_compare(self, size)
+            with self.recorder.part("scene"):
+                compare_view.draw_compare(self, size)
         else:
             self.draw_main(size)
             scene_labels.draw(state, origin, size)   # values, names, arrow names, probe sum
@@ -315,6 +353,7 @@ class Viewer:
             self._handle_click(self.image_with_input(vp.panes["main"].display, display_size),
                                display_size)
             return
+        self.recorder.begin("scene")  # the bench's breakdown: PASS 1-5 (read-backs apart)
         # --- PASS 1-2: the scene into the float target (the Renderer's passes), or the solved
         # radiosity meshes, Gouraud-interpolated (view-independent: walk around them)
         radiosity = state.offline.show_radiosity and state.offline.radiosity_soup is not None
@@ -326,7 +365,8 @@ class Viewer:
                                  self.samples(), terms_mask(state.view.terms_off))
         # --- PASS 3: the probe reads the GPU value before any overlay is drawn
         if state.probe.requested:
-            update_probe(state, vp, size, display_size, self.samples())
+            with self.recorder.part("readback"):
+                update_probe(state, vp, size, display_size, self.samples())
         # --- PASS 4: overlays (wireframe, normal glyphs, probe arrows)
         exposure = scene.render.exposure
         meshes = scene_meshes(scene)
@@ -351,8 +391,10 @@ class Viewer:
         texture = vp.present(pane, exposure, tonemap=state.view.tonemap,
                              clipping=state.view.show_clipping)
         if state.screenshot_requested:
-            write_viewport_screenshot(state, vp, state.screenshot_requested)
+            with self.recorder.part("readback"):
+                write_viewport_screenshot(state, vp, state.screenshot_requested)
             state.screenshot_requested = ""
+        self.recorder.end("scene")
         self._handle_click(self.image_with_input(texture, display_size), display_size)
 
     def samples(self) -> int:
@@ -400,7 +442,9 @@ class Viewer:
     def begin_frame(self) -> None:
         """Before any panel draws: the GPU work and images the panels queued last frame."""
         if self.gpu is not None:
-            guarded(lambda: self.gpu.flush(self.state.gpu), "GPU requests", self.report_error)
+            with self.recorder.part("gpu_requests"):
+                guarded(lambda: self.gpu.flush(self.state.gpu), "GPU requests",
+                        self.report_error)
             guarded(lambda: offline.update(self.state), "offline job", self.report_error)
         gizmos.begin_frame()
 
@@ -499,12 +543,12 @@ def _docking(viewer: Viewer) -> hello_imgui.DockingParams:
         window("Viewport", "MainDockSpace",
                lambda: guarded(viewer.draw_viewport_window, "viewport", viewer.report_error)),
         window("Equation & probe", "RightSpace", p(equation_panel.draw_equation_panel)),
-        window("Studies", "RightSpace", p(draw_studies_panel)),
-        window("Failure gallery", "RightSpace", p(draw_gallery_panel)),
+        window("Studies", "RightSpace", p(studies_panel.draw_studies_panel)),
+        window("Failure gallery", "RightSpace", p(studies_panel.draw_gallery_panel)),
         window("Offline render", "RightBottom", p(draw_offline_panel)),
-        window("Algorithms", "LeftSpace", p(draw_algorithms_panel)),
+        window("Algorithms", "LeftSpace", p(render_panel.draw_algorithms_panel)),
         window("Hemicube & F", "RightSpace", p(radiosity_view.draw_panel)),
-        window("Exercise", "RightSpace", p(draw_exercise_panel)),
+        window("Exercise", "RightSpace", p(exercise_panel.draw_exercise_panel)),
         window("Ray tree", "RightSpace", p(ray_tree_panel.draw_ray_tree_panel)),
     ]
     for w in params.dockable_windows:
@@ -514,6 +558,26 @@ def _docking(viewer: Viewer) -> hello_imgui.DockingParams:
     params.dockable_windows[0].focus_window_at_next_frame = True
     params.dockable_windows[5].focus_window_at_next_frame = True  # the right column's first tab
     return params
+
+
+def clear_with_window_bg(params: hello_imgui.RunnerParams | None = None) -> None:
+    """The theme's window background becomes the window's clear color, and windows draw none.
+
+    llvmpipe is fill-bound: the full-window windows (hello_imgui's dock space host, the
+    presenter's viewport window) each drew a window-sized background quad, blended, over the
+    clear: about 12 ms of a 1280x720 frame's CPU time, idle or not. ImGui draws no rect whose
+    alpha is 0, so WindowBg gets alpha 0 and the clear takes the color that quad blended to
+    over it: the same picture. (Dock windows already draw none; a window that wants one sets
+    its alpha, as Help does.)"""
+    style = imgui.get_style()
+    bg = style.color_(imgui.Col_.window_bg)
+    if bg.w > 0.0:
+        window = (params or hello_imgui.get_runner_params()).imgui_window_params
+        clear = window.background_color
+        window.background_color = imgui.ImVec4(*(c * bg.w + under * (1.0 - bg.w) for c, under in
+                                                 ((bg.x, clear.x), (bg.y, clear.y),
+                                                  (bg.z, clear.z))), 1.0)
+        style.set_color_(imgui.Col_.window_bg, imgui.ImVec4(bg.x, bg.y, bg.z, 0.0))
 
 
 def runner_params(viewer: Viewer) -> hello_imgui.RunnerParams:
@@ -538,6 +602,8 @@ def runner_params(viewer: Viewer) -> hello_imgui.RunnerParams:
     gl_options.anti_aliasing_samples = 0
     params.renderer_backend_options.open_gl_options = gl_options
     params.imgui_window_params.background_color = WINDOW_BG
+    params.callbacks.setup_imgui_style = lambda: clear_with_window_bg()  # after the theme
+    params.callbacks.theme_changed = lambda: clear_with_window_bg()
     params.docking_params = _docking(viewer)
     params.ini_disable = True
     # Idle at a few fps when nothing moves (frees the CPU for offline jobs); the bench and the
@@ -548,6 +614,11 @@ def runner_params(viewer: Viewer) -> hello_imgui.RunnerParams:
     params.callbacks.before_exit = viewer.before_exit
     params.callbacks.post_new_frame = viewer.begin_frame
     params.callbacks.after_swap = viewer.frame_swapped
+    # the bench's breakdown of a frame: the GUI built (panels, viewport passes within), then
+    # ImGui's draw lists drawn and the swap (FrameRecorder.frame_swapped ends that part)
+    params.callbacks.pre_new_frame = lambda: viewer.recorder.begin("gui")
+    params.callbacks.before_imgui_render = lambda: (viewer.recorder.end("gui"),
+                                                    viewer.recorder.begin("gui_render"))
     params.callbacks.show_gui = lambda: guarded(viewer.end_frame, "frame", viewer.report_error)
     return params
 

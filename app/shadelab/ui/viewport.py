@@ -46,9 +46,8 @@ class Viewport:
     def __init__(self, ctx: moderngl.Context):
         self.ctx = ctx
         self.renderer = Renderer(ctx)
-        self.display_program = load_program(ctx, "display")
         self.lines_program = load_program(ctx, "lines")
-        self.display_vao = ctx.vertex_array(self.display_program, [])
+        self._display_variants: dict[tuple, tuple] = {}  # (mode, tonemap, clip): program, vao
         self.panes: dict[str, Pane] = {}
         self.images: dict[str, moderngl.Texture] = {}  # CPU images (offline results)
         self._anchor = ctx.simple_framebuffer((1, 1))
@@ -160,17 +159,28 @@ class Viewport:
         self.ctx.enable_only(moderngl.NOTHING)
         source.target.color.use(0)
         (other or source).target.color.use(1)
-        program = self.display_program
+        program, vao = self.display_variant(1 if other is not None else 0,
+                                            1 if tonemap == "reinhard" else 0, int(clipping))
         set_uniform(program, "t_image", 0)
         set_uniform(program, "t_other", 1)
-        set_uniform(program, "u_mode", 1 if other is not None else 0)
         set_uniform(program, "u_exposure", float(exposure))
         set_uniform(program, "u_diff_scale", float(diff_scale))
-        set_uniform(program, "u_tonemap", 1 if tonemap == "reinhard" else 0)
-        set_uniform(program, "u_clipping", 1 if clipping else 0)
-        self.display_vao.render(moderngl.TRIANGLES, vertices=3)
+        vao.render(moderngl.TRIANGLES, vertices=3)
         self.restore()
         return pane.display
+
+    def display_variant(self, mode: int, tonemap: int, clipping: int):
+        """The display program compiled for one (mode, tone map, clipping) and its VAO (made on
+        first use): no masked branch runs for the others (shaders/display.frag)."""
+        key = (mode, tonemap, clipping)
+        variant = self._display_variants.get(key)
+        if variant is None:
+            program = load_program(self.ctx, "display", {"DISPLAY_MODE": mode,
+                                                         "DISPLAY_TONEMAP": tonemap,
+                                                         "DISPLAY_CLIPPING": clipping})
+            variant = self._display_variants[key] = (program,
+                                                     self.ctx.vertex_array(program, []))
+        return variant
 
     # ------------------------------------------------------------ read back
     def read_pixel(self, key: str, pixel: tuple[int, int]) -> np.ndarray:
@@ -216,8 +226,10 @@ class Viewport:
         self._thick_vao.release()
         self._thick_buffer.release()
         self.thick_program.release()
-        self.display_vao.release()
-        self.display_program.release()
+        for program, vao in self._display_variants.values():
+            vao.release()
+            program.release()
+        self._display_variants.clear()
         self.lines_program.release()
         self.renderer.release()
         (self.ctx.screen or self.ctx.detect_framebuffer(0)).use()
