@@ -58,7 +58,7 @@ from shadelab.constants import SHADING_EPS as EPS
 from shadelab.constants import T_INF
 from shadelab.errors import ShadeLabError
 from shadelab.progress import Progress
-from shadelab.raytrace import glossy, surface_rays, vertex
+from shadelab.raytrace import embree_direct, fused, glossy, surface_rays, vertex
 from shadelab.raytrace import rays as ray_kernels
 from shadelab.raytrace.accel import Hits, embree_available
 from shadelab.raytrace.sampler import SAMPLERS, SobolSampler
@@ -75,6 +75,8 @@ WAVEFRONT_PATHS = 65536  # an image smaller than a tile: sample passes per wavef
 MAX_BOUNCES = 64      # hard cap; Russian roulette ends paths long before
 RR_START = 4          # bounces before Russian roulette starts (3 cost 6 % more time at
                       # equal error on cornell: variance x CPU 0.85 against 0.80)
+FUSED = True          # trace whole paths in one numba loop where the scene allows
+                      # (PathTracer.fused; False keeps every render on the wavefront)
 
 
 def check_lit(scene: Scene, label: str) -> None:
@@ -208,7 +210,47 @@ class PathTracer:
         self.direct_materials[:, packing.M_LE:packing.M_LE + 3] = 0.0
         self.rays = 0  # counter of rays cast (paths and shadow rays)
         self.primary_hits = 0  # counter of camera rays that hit something
+        self._fused_scene = None
+        self._fused_tried = False
         self._hit_rows = np.zeros(0, bool)  # the last batch's camera rays that hit
+
+    def fused_scene(self) -> embree_direct.EmbreeScene | None:
+        """The Embree scene :func:`shadelab.raytrace.fused.trace_tile` traces whole paths
+        in, or None where the wavefront must: the numpy implementation, another accelerator
+        than Embree, the lecture's delta lights, textures or bumps, ``FUSED`` off, or no
+        Embree library to open (:mod:`shadelab.raytrace.embree_direct`)."""
+        if not self._fused_tried:
+            self._fused_tried = True
+            ctx = self.ctx
+            if (FUSED and ctx.kernels and ctx.accel.name == "embree" and not self.delta_lights
+                    and not ctx.detail.active):
+                self._fused_scene = embree_direct.embree_scene(ctx.geometry.triangles)
+        return self._fused_scene if FUSED else None
+
+    def trace_tile(self, camera, size: tuple[int, int], r0: int, r1: int, first: int,
+                   passes: int, seed: int) -> np.ndarray:
+        """Rows r0..r1 of Sobol' sample passes first .. first + passes - 1 in one numba
+        call (:func:`shadelab.raytrace.fused.trace_tile`; call where :meth:`fused_scene` is
+        not None): radiance summed over the passes ((r1 - r0) width, 3), the image the
+        wavefront traces bit for bit. ``camera`` = (eye, forward, right, up, tan_half)."""
+        em, ctx, g = self.emitters, self.ctx, self.ctx.geometry
+        es = self.fused_scene()
+        width, height = size
+        n = (r1 - r0) * width
+        out = np.empty((n, 3))
+        counts = np.zeros((n, 2), np.int64)
+        eye, forward, right, up, tan_half = camera
+        fused.trace_tile(
+            out, counts, (np.uint64(es.intersect), np.uint64(es.occluded), np.uint64(es.scene)),
+            eye, forward, right, up, float(tan_half), width, height, r0, r1, first, passes,
+            int(seed) & 0xFFFFFFFF, (self.rho, self.kr, self.kt, self.ior, self.emission),
+            (self.ks_os, self.shininess, self.p_glossy),
+            (em.cdf, em.p0, em.e1, em.e2, em.normal, em.le, float(em.total_area)),
+            (g.corner_normals, g.face_normals, g.object_index, ctx.object_material),
+            ctx.eps, ctx.background, RR_START, MAX_BOUNCES, self.blinn)
+        self.rays += int(counts[:, 0].sum())
+        self._hit_rows = counts[:, 1] > 0
+        return out
 
     def first_hits(self, n: int) -> int:
         """Of the last :meth:`radiance` batch's first ``n`` camera rays, how many hit."""
@@ -599,6 +641,12 @@ class TileJob:
         pass) of one tile."""
         width, height = self.size
         n = (r1 - r0) * width
+        if self.sampler == "sobol" and self.tracer.fused_scene() is not None:
+            before_rays = self.tracer.rays
+            radiance = self.tracer.trace_tile(
+                (self.eye, *self.frame, self.tan_half), self.size, r0, r1, sample, passes,
+                self.seed)
+            return radiance, self.tracer.rays - before_rays, self.tracer.first_hits(n)
         rng = np.random.default_rng([self.seed, sample, r0] if passes == 1
                                     else [self.seed, sample, r0, passes])
         sobol = None

@@ -122,30 +122,36 @@ def sobol_pairs(seed, pixels, pair, indices):
     return out
 
 
+@nb.njit(cache=True)
+def vertex_draws(ps, index, bounce, em_cdf):
+    """The 7 uniforms of path vertex ``bounce`` of sample ``index`` of the pixel whose seed is
+    ``ps`` (:func:`_pixel_seed`): emitter, 2 barycentrics, lobe, 2 direction, roulette, from
+    pairs 1 + 3b, 2 + 3b and 3 + 3b."""
+    base = 1 + 3 * bounce
+    n_em = len(em_cdf)
+    u, v = sample_2d(ps, base, index)
+    # the first barycentric variable: u re-scaled inside its triangle's CDF stretch
+    w = u
+    if n_em > 0:
+        k = min(np.searchsorted(em_cdf, u, side="right"), n_em - 1)
+        lo = em_cdf[k - 1] if k > 0 else 0.0
+        width = em_cdf[k] - lo
+        w = min(max((u - lo) / width, 0.0), 1.0 - 1e-16) if width > 0.0 else 0.5
+    d1, d2 = sample_2d(ps, base + 1, index)
+    lobe, roulette = sample_2d(ps, base + 2, index)
+    return u, w, v, lobe, d1, d2, roulette
+
+
 @nb.njit(cache=True, parallel=True)
 def vertex_uniforms(seed, pixels, indices, bounce, em_cdf):
     """The 7 uniforms per path of :func:`shadelab.raytrace.vertex.path_vertex` (emitter,
-    2 barycentrics, lobe, 2 direction, roulette) from pairs 1 + 3b, 2 + 3b and 3 + 3b of
-    sample ``indices[i]`` of pixel ``pixels[i]``."""
+    2 barycentrics, lobe, 2 direction, roulette; :func:`vertex_draws`) of sample
+    ``indices[i]`` of pixel ``pixels[i]``."""
     n = len(pixels)
     out = np.empty((n, 7))
-    base = 1 + 3 * bounce
-    n_em = len(em_cdf)
     for i in nb.prange(n):
-        ps = _pixel_seed(seed, pixels[i])
-        index = indices[i]
-        u, v = sample_2d(ps, base, index)
-        out[i, 0], out[i, 2] = u, v
-        # the first barycentric variable: u re-scaled inside its triangle's CDF stretch
-        w = u
-        if n_em > 0:
-            k = min(np.searchsorted(em_cdf, u, side="right"), n_em - 1)
-            lo = em_cdf[k - 1] if k > 0 else 0.0
-            width = em_cdf[k] - lo
-            w = min(max((u - lo) / width, 0.0), 1.0 - 1e-16) if width > 0.0 else 0.5
-        out[i, 1] = w
-        out[i, 4], out[i, 5] = sample_2d(ps, base + 1, index)
-        out[i, 3], out[i, 6] = sample_2d(ps, base + 2, index)
+        (out[i, 0], out[i, 1], out[i, 2], out[i, 3], out[i, 4], out[i, 5],
+         out[i, 6]) = vertex_draws(_pixel_seed(seed, pixels[i]), indices[i], bounce, em_cdf)
     return out
 
 
