@@ -52,6 +52,7 @@ from __future__ import annotations
 import time
 from typing import Iterator
 
+import numba
 import numpy as np
 
 from shadelab.constants import SHADING_EPS as EPS
@@ -240,14 +241,16 @@ class PathTracer:
         out = np.empty((n, 3))
         counts = np.zeros((n, 2), np.int64)
         eye, forward, right, up, tan_half = camera
-        fused.trace_tile(
-            out, counts, (np.uint64(es.intersect), np.uint64(es.occluded), np.uint64(es.scene)),
-            eye, forward, right, up, float(tan_half), width, height, r0, r1, first, passes,
-            int(seed) & 0xFFFFFFFF, (self.rho, self.kr, self.kt, self.ior, self.emission),
-            (self.ks_os, self.shininess, self.p_glossy),
-            (em.cdf, em.p0, em.e1, em.e2, em.normal, em.le, float(em.total_area)),
-            (g.corner_normals, g.face_normals, g.object_index, ctx.object_material),
-            ctx.eps, ctx.background, RR_START, MAX_BOUNCES, self.blinn)
+        with numba.parallel_chunksize(fused.DYNAMIC_CHUNKS):  # a thread that the machine's
+            fused.trace_tile(                                   # load slows takes fewer
+                out, counts, (np.uint64(es.intersect), np.uint64(es.occluded), np.uint64(es.scene)),
+                eye, forward, right, up, float(tan_half), width, height, r0, r1, first,
+                passes, int(seed) & 0xFFFFFFFF,
+                (self.rho, self.kr, self.kt, self.ior, self.emission),
+                (self.ks_os, self.shininess, self.p_glossy),
+                (em.cdf, em.p0, em.e1, em.e2, em.normal, em.le, float(em.total_area)),
+                (g.corner_normals, g.face_normals, g.object_index, ctx.object_material),
+                ctx.eps, ctx.background, RR_START, MAX_BOUNCES, self.blinn)
         self.rays += int(counts[:, 0].sum())
         self._hit_rows = counts[:, 1] > 0
         return out

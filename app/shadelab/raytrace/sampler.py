@@ -122,7 +122,7 @@ def sobol_pairs(seed, pixels, pair, indices):
     return out
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def vertex_draws(ps, index, bounce, em_cdf):
     """The 7 uniforms of path vertex ``bounce`` of sample ``index`` of the pixel whose seed is
     ``ps`` (:func:`_pixel_seed`): emitter, 2 barycentrics, lobe, 2 direction, roulette, from

@@ -48,7 +48,7 @@ def _specular_lobe(u, p_d, kr, kt, ior, entering, total, dx, dy, dz, nx, ny, nz,
     return ox, oy, oz, 1.0, kt, kt / total
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def next_event_ray(m, emitters, rho, lobes, b0, b1, b2, px, py, pz, nx, ny, nz, gx, gy, gz,
                    vx, vy, vz, prob_d, prob_s, blinn, eps, u0, u1, u2):
     """Next-event estimation at one vertex: a shadow ray to one point on the emitters, chosen
@@ -104,13 +104,16 @@ def _next_event(i, m, emitters, rho, lobes, beta, px, py, pz, nx, ny, nz, gx, gy
     nee_val[i, 0], nee_val[i, 1], nee_val[i, 2] = c0, c1, c2
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def continue_path(m, surfaces, lobes, b0, b1, b2, px, py, pz, nx, ny, nz, gx, gy, gz,
-                  dx, dy, dz, entering, p_d, p_s, total, prob_d, prob_s, eps, u_lobe, u1, u2,
-                  u_roulette, roulette, blinn):
+                  dx, dy, dz, entering, p_d, p_s, total, prob_d, prob_s, eps, uniforms,
+                  roulette, blinn):
     """Pick a lobe (diffuse, glossy, mirror, glass: their weights p_d, p_s, kr, kt of
     ``total`` > 0), sample it, and play Russian roulette: (alive, new origin, direction,
-    throughput, pdf of the direction for MIS: 0 after a mirror or glass bounce)."""
+    throughput, pdf of the direction for MIS: 0 after a mirror or glass bounce).
+    ``uniforms`` = (lobe, 2 direction, roulette). Fewer than 31 parameters: CPython passes
+    a longer call's arguments as *args, which numba cannot inline."""
+    u_lobe, u1, u2, u_roulette = uniforms
     rho, kr, kt, ior, emission = surfaces
     ks_os, shininess, p_glossy = lobes
     u = u_lobe * total
@@ -212,7 +215,7 @@ def path_vertex(out, pixel, beta, bsdf_pdf, position, normal, geo, entering, dir
          new_pdf[i]) = continue_path(m, surfaces, lobes, beta[i, 0], beta[i, 1], beta[i, 2],
                                      px, py, pz, nx, ny, nz, gx, gy, gz, dx, dy, dz,
                                      entering[i], p_d, p_s, total, prob_d, prob_s, eps,
-                                     rnd[i, 3], rnd[i, 4], rnd[i, 5], rnd[i, 6], roulette,
+                                     (rnd[i, 3], rnd[i, 4], rnd[i, 5], rnd[i, 6]), roulette,
                                      blinn)
     return nee_o, nee_d, nee_t, nee_ok, nee_val, new_o, new_d, new_beta, new_pdf, alive
 
