@@ -70,6 +70,8 @@ from shadelab.shading import kernels as shading_kernels
 from shadelab.shading import packing
 
 TILE_PATHS = 16384    # paths per work unit (one chunk of the generator)
+FUSED_TILE_PATHS = 1 << 18  # the same where whole paths run in one call (raytrace/fused.py):
+                            # a 1280 x 800 sample pass in 4 Progress steps, not 63
 WAVEFRONT_PATHS = 65536  # an image smaller than a tile: sample passes per wavefront up to
                          # this many paths (CPU per sample at 64 x 64 on 2 loaded cores:
                          # 1 pass 340 k samples/s, 4: 420 k, 16: 450 k, 64: 435 k)
@@ -580,12 +582,15 @@ def iter_pathtrace(scene: Scene, size: tuple[int, int], spp: int, seed: int = 0,
         raise ShadeLabError(f"--size {width}x{height}: expected each side >= 1")
     if spp < 1:
         raise ShadeLabError(f"--spp {spp}: expected an integer >= 1")
-    rows = max(1, TILE_PATHS // width)
+    setup = (scene, size, spp, seed, backend, local, sampler)
+    job_fn = TileJob(*setup) if workers <= 1 else None
+    # whole paths in one call: larger tiles (fewer Progress images to copy and send)
+    tile_paths = FUSED_TILE_PATHS if job_fn is not None and job_fn.fused else TILE_PATHS
+    rows = max(1, tile_paths // width)
     tiles = [(r, min(r + rows, height)) for r in range(0, height, rows)]
     batch = passes_per_job(size, spp)
     jobs = [(sample, r0, r1, min(batch, spp - sample)) for sample in range(0, spp, batch)
             for r0, r1 in tiles]
-    setup = (scene, size, spp, seed, backend, local, sampler)
     if workers > 1 and len(jobs) > 1:
         from shadelab.raytrace.pool import traced_in_pool
 
@@ -594,7 +599,7 @@ def iter_pathtrace(scene: Scene, size: tuple[int, int], spp: int, seed: int = 0,
         name = "embree" if backend == "embree" or (backend == "auto" and embree_available()) \
             else "bvh"
     else:
-        job_fn = TileJob(*setup)
+        job_fn = TileJob(*setup) if job_fn is None else job_fn
         results = ((job, job_fn(*job)) for job in jobs)
         name = job_fn.tracer.ctx.accel.name
     total = np.zeros((height * width, 3))
@@ -639,12 +644,17 @@ class TileJob:
         self.eye = np.asarray(cam.eye, dtype=np.float64)
         self.tan_half = tan_half_fov_y(cam, size[0] / size[1])
 
+    @property
+    def fused(self) -> bool:
+        """Whole paths in one numba call (:meth:`PathTracer.trace_tile`) for this job."""
+        return self.sampler == "sobol" and self.tracer.fused_scene() is not None
+
     def __call__(self, sample: int, r0: int, r1: int, passes: int = 1):
         """(radiance summed over the passes (n, 3), rays cast, primary hits of the first
         pass) of one tile."""
         width, height = self.size
         n = (r1 - r0) * width
-        if self.sampler == "sobol" and self.tracer.fused_scene() is not None:
+        if self.fused:
             before_rays = self.tracer.rays
             radiance = self.tracer.trace_tile(
                 (self.eye, *self.frame, self.tan_half), self.size, r0, r1, sample, passes,
