@@ -109,3 +109,20 @@ def test_scenes_the_fused_kernel_leaves_to_the_wavefront(preset, overrides, monk
         monkeypatch.setattr(PathTracer, "trace_tile", lambda *a: calls.append(a))
         render_pathtraced(scene, (8, 6), 2)
         assert not calls
+
+
+def test_the_viewport_job_goes_from_a_quarter_size_to_full_size():
+    """The path tracer's viewer levels are 1/8, 1/4, full (no half size before the first
+    full-resolution sample); ``level_work`` counts a level's samples, so the viewer knows
+    when a full pass is on screen; the last image is the full render at the scene's spp."""
+    from shadelab.pipelines import registry
+
+    scene = load_preset("cornell", ["raytrace.spp=4"])
+    size = (40, 24)
+    steps = list(registry.get("pathtrace").viewport_job(scene, size))
+    assert [s for s in dict.fromkeys(step.stats["level"] for step in steps)] == [8, 4, 1]
+    full = [step for step in steps if step.stats["level"] == 1]
+    first = next(step for step in full if step.stats["level_work"] >= size[0] * size[1])
+    # the first whole pass: each pixel's Sobol' sample 0, the one-sample image
+    np.testing.assert_array_equal(first.image, render_pathtraced(scene, size, 1, seed=1))
+    np.testing.assert_array_equal(steps[-1].image, render_pathtraced(scene, size, 4, seed=1))
