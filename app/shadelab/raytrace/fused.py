@@ -12,7 +12,15 @@ the same float32 rays into the same Embree build, the contributions summed in th
 order, so the image is the wavefront's bit for bit (tests/raytrace/test_fused.py).
 
 Used for the Sobol' sampler on scenes without the lecture's delta lights and textures (the
-Cornell boxes); the rest stays on the wavefront.
+Cornell boxes); the rest stays on the wavefront (``pathtrace.FUSED = False`` or
+``SHADELAB_EMBREE_DIRECT=0`` keeps every render there).
+
+Speed: each pixel is one call of :func:`trace_pixel`, into which numba inlines the vertex and
+the draws (``inline="always"``: without it every call passed the material and emitter arrays
+and counted their references, and a sample cost 2.5 us of CPU instead of 1.6). A call of 31 or
+more arguments reaches numba as ``*args``, which it cannot inline: keep the inlined helpers'
+calls shorter. On cornell (64 x 64, 64 spp) a sample costs about 0.9 us in Embree (six rays,
+robust mode, as embreex builds) and 0.7 us here.
 """
 
 from __future__ import annotations

@@ -45,6 +45,11 @@ Samples: by default (``raytrace.sampler = "sobol"``) every 2-D decision of a pat
 jitter, emitter point, BSDF direction, lobe choice and roulette) draws Owen-scrambled
 Sobol' points per pixel (:mod:`shadelab.raytrace.sampler`), so each pixel's samples are
 stratified in each pair; ``"independent"`` draws uniforms from each tile's generator.
+
+Execution: with Sobol' samples, Embree and neither delta lights nor textures, whole paths run
+in one parallel numba call per tile (:mod:`shadelab.raytrace.fused`, Embree called ray by
+ray), the image the bounce-by-bounce wavefront below traces bit for bit; the wavefront does
+the rest (and ``FUSED = False`` forces it).
 """
 
 from __future__ import annotations
