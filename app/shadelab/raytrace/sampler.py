@@ -57,16 +57,22 @@ def _hash(x):
 
 
 @nb.njit(cache=True, inline="always")
-def _owen(v, seed):
-    """Nested uniform (Owen) scramble of the 32-bit fraction v, seeded (pbrt-v4's
-    FastOwenScrambler: Laine-Karras on the reversed bits)."""
-    v = _reverse_bits(v)
+def _laine_karras(v, seed):
+    """The Laine-Karras hash of the bit-reversed fraction v (a nested uniform scramble of
+    the fraction itself), seeded."""
     v ^= (v * 0x3D20ADEA) & _MASK
     v = (v + seed) & _MASK
     v = (v * ((seed >> 16) | 1)) & _MASK
     v ^= (v * 0x05526C56) & _MASK
     v ^= (v * 0x53A22864) & _MASK
-    return _reverse_bits(v)
+    return v
+
+
+@nb.njit(cache=True, inline="always")
+def _owen(v, seed):
+    """Nested uniform (Owen) scramble of the 32-bit fraction v, seeded (pbrt-v4's
+    FastOwenScrambler: Laine-Karras on the reversed bits)."""
+    return _reverse_bits(_laine_karras(_reverse_bits(v), seed))
 
 
 def _dimension1_bytes() -> np.ndarray:
@@ -106,9 +112,9 @@ def sample_2d(pixel_seed, pair, index):
     """The (u, v) in [0, 1)^2 of sample ``index`` of one pixel's pair of dimensions."""
     h = _hash(pixel_seed ^ _hash(pair + 0x68E31DA4))
     j = _owen(index & _MASK, h)
-    x, y = _sobol2(j)
-    x = _owen(x, _hash(h ^ 0x1B873593))
-    y = _owen(y, _hash(h ^ 0xCC9E2D51))
+    # dimension 0 is j bit-reversed, so its scramble _owen(reverse(j)) skips two reversals
+    x = _reverse_bits(_laine_karras(j, _hash(h ^ 0x1B873593)))
+    y = _owen(_sobol2(j)[1], _hash(h ^ 0xCC9E2D51))
     return x * _TO_UNIT, y * _TO_UNIT
 
 
