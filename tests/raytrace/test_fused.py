@@ -126,3 +126,17 @@ def test_the_viewport_job_goes_from_a_quarter_size_to_full_size():
     # the first whole pass: each pixel's Sobol' sample 0, the one-sample image
     np.testing.assert_array_equal(first.image, render_pathtraced(scene, size, 1, seed=1))
     np.testing.assert_array_equal(steps[-1].image, render_pathtraced(scene, size, 4, seed=1))
+
+
+def test_fused_jobs_hold_more_paths():
+    """Whole paths in one call: a small image's passes go together up to 2^18 paths a call
+    (a pixel's samples in a row), a large one in tiles of 2^18 paths; the wavefront's rule
+    is unchanged."""
+    from shadelab.raytrace.pathtrace import FUSED_TILE_PATHS, passes_per_job
+
+    assert FUSED_TILE_PATHS == 1 << 18
+    assert passes_per_job((128, 128), 64, fused=True) == 16
+    assert passes_per_job((128, 128), 64) == 1
+    assert passes_per_job((64, 64), 64, fused=True) == 16
+    assert passes_per_job((1280, 800), 64, fused=True) == 1
+    assert passes_per_job((256, 256), 3, fused=True) == 1

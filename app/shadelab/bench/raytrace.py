@@ -114,7 +114,7 @@ def _pathtrace(size: tuple[int, int], spp: int, sampler: str = "sobol"):
     scene = load_preset("cornell")
     job = TileJob(scene, size, spp, 0, "auto", "numba", sampler)
     tracer = job.tracer
-    batch = passes_per_job(size, spp)
+    batch = passes_per_job(size, spp, job.fused)
 
     def render():
         for sample in range(0, spp, batch):

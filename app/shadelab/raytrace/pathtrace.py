@@ -554,14 +554,18 @@ def _add(out: np.ndarray, pixel: np.ndarray, value: np.ndarray) -> None:
             out[:, c] += np.bincount(pixel, weights=value[:, c], minlength=len(out))
 
 
-def passes_per_job(size: tuple[int, int], spp: int) -> int:
+def passes_per_job(size: tuple[int, int], spp: int, fused: bool = False) -> int:
     """Sample passes per job: an image smaller than a tile traces several in one wavefront
     of up to WAVEFRONT_PATHS paths (the per-bounce overheads shared), in at least
-    min(spp, 4) jobs (progress to show, a cancel to honour)."""
+    min(spp, 4) jobs (progress to show, a cancel to honour). ``fused`` (whole paths in one
+    call): tiles and calls of up to FUSED_TILE_PATHS paths, a pixel's passes in a row (at
+    128 x 128 x 64 on cornell: 1.85 us of CPU a sample against 1.9 to 2.4 one pass a call)."""
     pixels = size[0] * size[1]
-    if pixels >= TILE_PATHS:
+    tile, paths = (FUSED_TILE_PATHS, FUSED_TILE_PATHS) if fused else (TILE_PATHS,
+                                                                     WAVEFRONT_PATHS)
+    if pixels >= tile:
         return 1
-    return max(1, min(-(-spp // 4), WAVEFRONT_PATHS // pixels))
+    return max(1, min(-(-spp // 4), paths // pixels))
 
 
 def iter_pathtrace(scene: Scene, size: tuple[int, int], spp: int, seed: int = 0,
@@ -593,7 +597,7 @@ def iter_pathtrace(scene: Scene, size: tuple[int, int], spp: int, seed: int = 0,
     tile_paths = FUSED_TILE_PATHS if job_fn is not None and job_fn.fused else TILE_PATHS
     rows = max(1, tile_paths // width)
     tiles = [(r, min(r + rows, height)) for r in range(0, height, rows)]
-    batch = passes_per_job(size, spp)
+    batch = passes_per_job(size, spp, tile_paths == FUSED_TILE_PATHS)
     jobs = [(sample, r0, r1, min(batch, spp - sample)) for sample in range(0, spp, batch)
             for r0, r1 in tiles]
     if workers > 1 and len(jobs) > 1:
