@@ -27,3 +27,23 @@ def test_the_mask_leaves_out_the_light_and_its_ring():
     images[:, 2, 3] += np.array([0.0, 5.0, -5.0])[:, None]     # the light's noise
     only_walls = variance_per_sample(images, 1, mask)
     assert np.isclose(only_walls, (np.var([0, 0, 0.01], ddof=1)) / (0.1 + 0.01 / 3) ** 2)
+
+
+def test_the_per_sampler_rows_carry_speed_noise_and_the_ratio():
+    """``by_sampler``: one row per Mitsuba sampler with both samples/s and noise figures and
+    the equal-error ratio the bench paired (their time to a given error over ours)."""
+    from shadelab.bench.raytrace import by_sampler
+
+    ours = {"sobol": {"samples_per_s": 3e5, "variance_per_sample": 0.30}}
+    theirs = {"ldsampler": {"samples_per_s": 5e5, "variance_per_sample": 0.31},
+              "independent": {"samples_per_s": 6e5, "variance_per_sample": 0.57}}
+    ratios = {f"sobol_vs_{name}": {"equal_error_ratio": (3e5 / t["samples_per_s"])
+                                   * t["variance_per_sample"] / 0.30,
+                                   "equal_error_ratio_cpu": 1.0}
+              for name, t in theirs.items()}
+    rows = by_sampler({"ours": ours, "mitsuba": theirs, "ratios": ratios})
+    assert set(rows) == {"ldsampler", "independent"}
+    row = rows["ldsampler"]
+    assert row["ours_samples_per_s"] == 3e5 and row["mitsuba_noise_per_sample"] == 0.31
+    assert np.isclose(row["equal_error_ratio"], 0.6 * 0.31 / 0.30)
+    assert np.isclose(rows["independent"]["equal_error_ratio"], 0.5 * 0.57 / 0.30)

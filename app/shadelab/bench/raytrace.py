@@ -5,6 +5,7 @@ scene, the numba BVH's, and the path tracer's samples/s on cornell."""
 from __future__ import annotations
 
 import math
+import os
 import time
 
 import numba
@@ -113,7 +114,7 @@ def _pathtrace(size: tuple[int, int], spp: int, sampler: str = "sobol"):
     scene = load_preset("cornell")
     job = TileJob(scene, size, spp, 0, "auto", "numba", sampler)
     tracer = job.tracer
-    batch = passes_per_job(size, spp)
+    batch = passes_per_job(size, spp, job.fused)
 
     def render():
         for sample in range(0, spp, batch):
@@ -231,6 +232,7 @@ def pathtrace_vs_mitsuba(size, spp: int, repeats: int, seeds: int = 4) -> dict:
     from shadelab.raytrace.pathtrace import render_pathtraced
 
     scene = load_preset("cornell")
+    load_before = os.getloadavg()
     fns, ours, theirs = {}, {}, {}
     for name in OUR_SAMPLERS:
         fns[f"ours_{name}"], ours[name] = _pathtrace(size, spp, name)
@@ -279,9 +281,28 @@ def pathtrace_vs_mitsuba(size, spp: int, repeats: int, seeds: int = 4) -> dict:
                 # wall clock blurs
                 "samples_per_cpu_s_ratio": cpu, "equal_error_ratio_cpu": cpu * noise}
     return {"size": list(size), "spp": spp, "seeds": seeds, "repeats": repeats,
+            "load_avg": {"before": list(load_before), "after": list(os.getloadavg())},
             "pixels": "away from the light's outline (away_from_emitters)",
             "ours": {k: _public(v) for k, v in ours.items()},
             "mitsuba": {k: _public(v) for k, v in theirs.items()}, "ratios": ratios}
+
+
+def by_sampler(pt: dict, ours: str = "sobol") -> dict:
+    """One row per Mitsuba sampler: samples/s and noise per sample (``variance_per_sample``)
+    of ours and theirs, and the equal-error ratio (their time to a given error over ours: the
+    paired samples/s ratio times their noise over ours; > 1: we get there first), per wall
+    second and per CPU second."""
+    mine = pt["ours"][ours]
+    rows = {}
+    for name, info in pt["mitsuba"].items():
+        ratio = pt["ratios"][f"{ours}_vs_{name}"]
+        rows[name] = {"ours_samples_per_s": mine["samples_per_s"],
+                      "mitsuba_samples_per_s": info["samples_per_s"],
+                      "ours_noise_per_sample": mine["variance_per_sample"],
+                      "mitsuba_noise_per_sample": info["variance_per_sample"],
+                      "equal_error_ratio": ratio["equal_error_ratio"],
+                      "equal_error_ratio_cpu": ratio["equal_error_ratio_cpu"]}
+    return rows
 
 
 def _public(info: dict) -> dict:
@@ -343,6 +364,7 @@ def run(quick: bool) -> dict:
         report["pathtrace_vs_mitsuba_equal_error_by_sampler"] = {
             name: v["equal_error_ratio"] for name, v in versus.items()}
         report["pathtrace_vs_mitsuba_equal_error_cpu"] = versus[best]["equal_error_ratio_cpu"]
+        report["pathtrace_by_mitsuba_sampler"] = by_sampler(pt)
     else:
         report["pathtrace_vs_mitsuba"] = None
         report["pathtrace_vs_mitsuba_why"] = ("mitsuba not available here: "

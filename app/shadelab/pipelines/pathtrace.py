@@ -12,6 +12,9 @@ from shadelab.progress import Progress
 from shadelab.scene.model import Scene
 
 DEFAULT_SPP = 64   # shadelab.render's and shadelab pathtrace's samples per pixel
+VIEWPORT_LEVELS = (8, 4, 1)   # the viewer's levels: no half size (a quarter of a full pass
+                              # before the first full-resolution sample; the full level
+                              # refines in place, sample by sample)
 
 
 class PathtracePipeline(BasePipeline):
@@ -46,6 +49,13 @@ class PathtracePipeline(BasePipeline):
     def job(self, scene: Scene, size: tuple[int, int]) -> Iterator[Progress]:
         """At the scene's samples per pixel (the Offline panel sets them)."""
         return self.run(scene, size, max(scene.raytrace.spp, 1), seed=1)
+
+    def viewport_job(self, scene: Scene, size: tuple[int, int]) -> Iterator[Progress]:
+        """Coarse to fine at :data:`VIEWPORT_LEVELS`: 1/8 and 1/4 size at one sample, then
+        full size at the scene's samples per pixel."""
+        from shadelab.pipelines.progressive import progressive
+
+        return progressive(self, scene, size, VIEWPORT_LEVELS)
 
     def level_options(self, scene: Scene, divisor: int) -> dict:
         return {"spp": max(int(scene.raytrace.spp), 1) if divisor == 1 else 1, "seed": 1}

@@ -54,5 +54,6 @@ def _levels(pipeline, scene, size, levels, options) -> Iterator[Progress]:
             yield Progress(step.image, (li + step.fraction) / len(levels),
                            f"1/{div} resolution ({sub[0]}x{sub[1]}), {step.message}, "
                            f"{total + done} {unit}",
-                           {"level": div, "size": sub, unit: total + done, "unit": unit})
+                           {"level": div, "size": sub, unit: total + done, "unit": unit,
+                            "level_work": done})
         total += done

@@ -57,16 +57,22 @@ def _hash(x):
 
 
 @nb.njit(cache=True, inline="always")
-def _owen(v, seed):
-    """Nested uniform (Owen) scramble of the 32-bit fraction v, seeded (pbrt-v4's
-    FastOwenScrambler: Laine-Karras on the reversed bits)."""
-    v = _reverse_bits(v)
+def _laine_karras(v, seed):
+    """The Laine-Karras hash of the bit-reversed fraction v (a nested uniform scramble of
+    the fraction itself), seeded."""
     v ^= (v * 0x3D20ADEA) & _MASK
     v = (v + seed) & _MASK
     v = (v * ((seed >> 16) | 1)) & _MASK
     v ^= (v * 0x05526C56) & _MASK
     v ^= (v * 0x53A22864) & _MASK
-    return _reverse_bits(v)
+    return v
+
+
+@nb.njit(cache=True, inline="always")
+def _owen(v, seed):
+    """Nested uniform (Owen) scramble of the 32-bit fraction v, seeded (pbrt-v4's
+    FastOwenScrambler: Laine-Karras on the reversed bits)."""
+    return _reverse_bits(_laine_karras(_reverse_bits(v), seed))
 
 
 def _dimension1_bytes() -> np.ndarray:
@@ -106,9 +112,9 @@ def sample_2d(pixel_seed, pair, index):
     """The (u, v) in [0, 1)^2 of sample ``index`` of one pixel's pair of dimensions."""
     h = _hash(pixel_seed ^ _hash(pair + 0x68E31DA4))
     j = _owen(index & _MASK, h)
-    x, y = _sobol2(j)
-    x = _owen(x, _hash(h ^ 0x1B873593))
-    y = _owen(y, _hash(h ^ 0xCC9E2D51))
+    # dimension 0 is j bit-reversed, so its scramble _owen(reverse(j)) skips two reversals
+    x = _reverse_bits(_laine_karras(j, _hash(h ^ 0x1B873593)))
+    y = _owen(_sobol2(j)[1], _hash(h ^ 0xCC9E2D51))
     return x * _TO_UNIT, y * _TO_UNIT
 
 
@@ -122,30 +128,36 @@ def sobol_pairs(seed, pixels, pair, indices):
     return out
 
 
+@nb.njit(cache=True, inline="always")
+def vertex_draws(ps, index, bounce, em_cdf):
+    """The 7 uniforms of path vertex ``bounce`` of sample ``index`` of the pixel whose seed is
+    ``ps`` (:func:`_pixel_seed`): emitter, 2 barycentrics, lobe, 2 direction, roulette, from
+    pairs 1 + 3b, 2 + 3b and 3 + 3b."""
+    base = 1 + 3 * bounce
+    n_em = len(em_cdf)
+    u, v = sample_2d(ps, base, index)
+    # the first barycentric variable: u re-scaled inside its triangle's CDF stretch
+    w = u
+    if n_em > 0:
+        k = min(np.searchsorted(em_cdf, u, side="right"), n_em - 1)
+        lo = em_cdf[k - 1] if k > 0 else 0.0
+        width = em_cdf[k] - lo
+        w = min(max((u - lo) / width, 0.0), 1.0 - 1e-16) if width > 0.0 else 0.5
+    d1, d2 = sample_2d(ps, base + 1, index)
+    lobe, roulette = sample_2d(ps, base + 2, index)
+    return u, w, v, lobe, d1, d2, roulette
+
+
 @nb.njit(cache=True, parallel=True)
 def vertex_uniforms(seed, pixels, indices, bounce, em_cdf):
     """The 7 uniforms per path of :func:`shadelab.raytrace.vertex.path_vertex` (emitter,
-    2 barycentrics, lobe, 2 direction, roulette) from pairs 1 + 3b, 2 + 3b and 3 + 3b of
-    sample ``indices[i]`` of pixel ``pixels[i]``."""
+    2 barycentrics, lobe, 2 direction, roulette; :func:`vertex_draws`) of sample
+    ``indices[i]`` of pixel ``pixels[i]``."""
     n = len(pixels)
     out = np.empty((n, 7))
-    base = 1 + 3 * bounce
-    n_em = len(em_cdf)
     for i in nb.prange(n):
-        ps = _pixel_seed(seed, pixels[i])
-        index = indices[i]
-        u, v = sample_2d(ps, base, index)
-        out[i, 0], out[i, 2] = u, v
-        # the first barycentric variable: u re-scaled inside its triangle's CDF stretch
-        w = u
-        if n_em > 0:
-            k = min(np.searchsorted(em_cdf, u, side="right"), n_em - 1)
-            lo = em_cdf[k - 1] if k > 0 else 0.0
-            width = em_cdf[k] - lo
-            w = min(max((u - lo) / width, 0.0), 1.0 - 1e-16) if width > 0.0 else 0.5
-        out[i, 1] = w
-        out[i, 4], out[i, 5] = sample_2d(ps, base + 1, index)
-        out[i, 3], out[i, 6] = sample_2d(ps, base + 2, index)
+        (out[i, 0], out[i, 1], out[i, 2], out[i, 3], out[i, 4], out[i, 5],
+         out[i, 6]) = vertex_draws(_pixel_seed(seed, pixels[i]), indices[i], bounce, em_cdf)
     return out
 
 

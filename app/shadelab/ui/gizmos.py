@@ -71,6 +71,20 @@ def pixel_size_at(state: AppState, point, height: int, width: int = 0) -> float:
     return 2.0 * depth * tan_half_fov_y(cam, width / max(height, 1)) / max(height, 1)
 
 
+SURFACE_LIT = ("pathtrace", "radiosity")  # pipelines lit by the surface a stand-in stands for
+
+
+def shown(state: AppState, light) -> bool:
+    """False for a ``stand_in`` light in a pipeline that lights with the emitting surface it
+    stands for (path tracing, radiosity): that surface is drawn, and the glyph and handle of
+    a light that does nothing there would sit on it."""
+    if not light.stand_in:
+        return True
+    from shadelab.lab.pipeline_view import current
+
+    return current(state) not in SURFACE_LIT
+
+
 def draw(state: AppState, origin, size: tuple[int, int]) -> bool:
     """Glyphs for every light and the ImGuizmo of the selected one; True when it moved."""
     global _using
@@ -84,10 +98,15 @@ def draw(state: AppState, origin, size: tuple[int, int]) -> bool:
     span = float(np.linalg.norm(np.subtract(cam.target, cam.eye))) or 1.0
     selected = min(max(state.view.gizmo_light, 0), len(state.scene.lights) - 1)
     for i, light in enumerate(state.scene.lights):
+        if not shown(state, light):
+            continue
         color = (SELECTED_COLOR if i == selected else GLYPH_COLOR) if light.enabled \
             else GLYPH_OFF_COLOR
         _draw_glyph(draw_list, project, origin, light, color, scale, span)
     light = state.scene.lights[selected]
+    if not shown(state, light):
+        _using = False
+        return False
     forward = np.subtract(cam.target, cam.eye) / span
     depth = float(np.dot(np.subtract(light.position, cam.eye), forward))
     if light_kind(light).at_infinity or (depth <= cam.near and not _using):

@@ -28,6 +28,7 @@ from shadelab.ui.pipelines import (
     pick_ray_tree,
     poll,
     prefetch_tick,
+    project,
     shooter_outline,
     status_line,
     sync,
@@ -94,9 +95,14 @@ def draw(viewer: ViewportHost, display_size: tuple[int, int]) -> bool:
         label(draw_list, imgui.ImVec2(x + 8, origin.y + display_size[1] - 28), LABELS[other])
     if name == "raytrace" and view.ray_tree is not None:
         draw_ray_tree(state, draw_list, origin, display_size)
-    # wrapped to the viewport, left of the fps readout (presenter fonts made them overlap)
-    label(draw_list, imgui.ImVec2(origin.x + 8, origin.y + 8), status_line(state),
-          max(display_size[0] - 16 - presenter.readout_width(state), 80.0))
+    # wrapped to the viewport, left of the fps readout (presenter fonts made them overlap),
+    # in a corner where it hides no emitter (the Cornell light: what the path tracer's first
+    # samples show)
+    text = status_line(state)
+    x, y, wrap = status_place(display_size, lambda w: tuple(imgui.calc_text_size(text, False, w)),
+                              emitter_rect(state.scene, display_size),
+                              presenter.readout_width(state))
+    label(draw_list, imgui.ImVec2(origin.x + x, origin.y + y), text, wrap)
     if clicked is not None:
         pick_ray_tree(state, name, clicked, display_size)
     if state.screenshot_requested:
@@ -134,6 +140,46 @@ def draw_on_top(state, origin, display_size: tuple[int, int]) -> None:
         low = outline[:, 1].max() + thick + 4.0
         label(draw_list, imgui.ImVec2(origin.x + float(outline[:, 0].min()), origin.y + low),
               f"shooting: patch {index}")
+def emitter_rect(scene, size: tuple[int, int]) -> tuple[float, float, float, float] | None:
+    """Screen bounds (x0, y0, x1, y1) in a viewport of ``size`` of the objects whose material
+    emits, clipped to it; None when no emitter is in view."""
+    from shadelab.geometry.mesh import object_mesh
+
+    points = [object_mesh(obj, i, scene.base_dir).vertices for i, obj in enumerate(scene.objects)
+              if max(scene.materials[obj.material].emission) > 0.0]
+    if not points:
+        return None
+    xy, front = project(scene, size, np.concatenate(points))
+    if not front.any():
+        return None
+    (x0, y0), (x1, y1) = xy[front].min(axis=0), xy[front].max(axis=0)
+    x0, y0, x1, y1 = max(x0, 0.0), max(y0, 0.0), min(x1, size[0]), min(y1, size[1])
+    return (float(x0), float(y0), float(x1), float(y1)) if x0 < x1 and y0 < y1 else None
+
+
+def status_place(size: tuple[int, int], measure, emitters, readout: float = 0.0,
+                 margin: float = 8.0) -> tuple[float, float, float]:
+    """(x, y, wrap) of the status box in a viewport of ``size``: top left, wrapped before the
+    fps readout; where that box would cover the ``emitters`` rectangle (:func:`emitter_rect`),
+    bottom left; where that covers them too, top left wrapped to end before them.
+    ``measure(wrap)`` is the text's (width, height) wrapped at ``wrap`` pixels."""
+    wrap = max(size[0] - 2 * margin - readout, 80.0)
+    w, h = measure(wrap)
+
+    def free(x, y, width, height):
+        if emitters is None:
+            return True
+        x0, y0, x1, y1 = emitters
+        pad = 4.0   # the box's own padding (label) and a pixel of air
+        return x + width + pad <= x0 or x - pad >= x1 or y + height + pad <= y0 or y - pad >= y1
+
+    if free(margin, margin, w, h):
+        return margin, margin, wrap
+    bottom = size[1] - margin - h
+    if bottom > margin and free(margin, bottom, w, h):
+        return margin, bottom, wrap
+    narrow = max(emitters[0] - 2 * margin, 80.0)
+    return margin, margin, min(narrow, wrap)
 
 
 def _v(name: str, end: int) -> float:

@@ -74,10 +74,13 @@ class JobRecord:
     done_s: float | None = None
     reused_form_factors: bool | None = None
     prefetched: bool | None = None      # adopted from the lesson's prefetch (lab/prefetch.py)
+    first_full_s: float | None = None   # a full-size level's first whole pass shown (one
+                                        # sample per pixel of the path tracer)
 
     def as_dict(self) -> dict:
         return {"name": self.name, "size": list(self.size), "started_s": self.started_s,
                 "first_image_s": self.first_image_s, "done_s": self.done_s,
+                **({} if self.first_full_s is None else {"first_full_s": self.first_full_s}),
                 **({} if self.reused_form_factors is None
                    else {"form_factors_reused": self.reused_form_factors}),
                 **({} if self.prefetched is None else {"prefetched": self.prefetched})}
@@ -292,6 +295,10 @@ def _take(state: AppState) -> None:
         got_image = True
     if record is not None and got_image and record.first_image_s is None:
         record.first_image_s = since_start(time.perf_counter())
+    if record is not None and got_image and record.first_full_s is None \
+            and stats.get("level") == 1 and "size" in stats \
+            and stats.get("level_work", 0) >= stats["size"][0] * stats["size"][1]:
+        record.first_full_s = since_start(time.perf_counter())
     if record is not None and "form_factors_reused" in stats:
         record.reused_form_factors = bool(stats["form_factors_reused"])
 
