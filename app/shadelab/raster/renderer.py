@@ -442,7 +442,10 @@ class Renderer:
         method = scene.render.shadow_method
         for index, light in enumerate(lights):
             volumes = shadows.volumes(scene, gpu_meshes, index, light)
-            passes = self._stencil_for_light(scene, target, view, volumes, method, light)
+            # the first light counts on the stencil the frame's clear left at 0 (pass 1; the
+            # ambient pass writes no stencil)
+            passes = self._stencil_for_light(scene, target, view, volumes, method, light,
+                                             stencil_clean=index == 0)
             for ref, lit in passes:
                 self.ctx.enable_only(moderngl.DEPTH_TEST | moderngl.BLEND)
                 self.ctx.blend_func = moderngl.ONE, moderngl.ONE
@@ -465,7 +468,8 @@ class Renderer:
             self.set_frame_lights(variant, lights, ambient_on=1.0)
 
     def _stencil_for_light(self, scene: Scene, target: RenderTarget, view: View, volumes,
-                           method: str, light: Light) -> list[tuple[int, Light]]:
+                           method: str, light: Light,
+                           stencil_clean: bool = False) -> list[tuple[int, Light]]:
         """Fill the stencil for one light; return its lit passes as (stencil value, light).
 
         Opaque casters only: the volume count, one pass where it is 0 (S_i = 1). With
@@ -485,7 +489,7 @@ class Renderer:
         clear = [v for v in volumes
                  if is_transparent(scene.materials[scene.objects[v.object_index].material])]
         if not clear:
-            shadows.count(target, view, volumes, method)
+            shadows.count(target, view, volumes, method, clear=not stencil_clean)
             return [(0, light)]
         filters = clear[:FILTER_SLOTS]       # further transparent casters cast no shadow
         opaque = [v for v in volumes if v not in clear]

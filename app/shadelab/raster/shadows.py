@@ -92,6 +92,8 @@ class ShadowVolumes:
         self._closed: dict[tuple, bool] = {}  # geometry key -> closed caster?
         self._grouping: dict[tuple, list[list[int]]] = {}  # recent groupings of open casters
         self._skips: dict[tuple, list[bool]] = {}  # recent shadows_nothing answers
+        self._offset_key: tuple | None = None   # the meshes _offset_value was measured on
+        self._offset_value = 0.0
         quad = np.array([[-1, -1, 1, 1], [1, -1, 1, 1], [1, 1, 1, 1],
                          [-1, -1, 1, 1], [1, 1, 1, 1], [-1, 1, 1, 1]], dtype=np.float32)
         self._quad_vbo = ctx.buffer(quad.tobytes())
@@ -108,8 +110,7 @@ class ShadowVolumes:
         is counted alone for its filter flag); the other open casters are grouped by shared
         corners and each group gets one :func:`open_volume` (the union of their per-triangle
         volumes without the sides that cancel: the same count, far less fill)."""
-        offset = OFFSET_FRACTION * float(np.linalg.norm(np.ptp(
-            scene_bounds([g.mesh for g in gpu_meshes]), axis=0)))
+        offset = self._offset(gpu_meshes)
         homogeneous = light_kind(light).homogeneous()
         out = []
         live = set()
@@ -139,6 +140,16 @@ class ShadowVolumes:
         for slot in [s for s in self._cache if s[1] == light_index and s not in live]:
             self._cache.pop(slot).release()
         return out
+
+    def _offset(self, gpu_meshes) -> float:
+        """OFFSET_FRACTION of the scene's diagonal, memoized on every mesh's geometry (scanning
+        every vertex each frame cost ~1.5 ms of the lecture frame's main thread)."""
+        key = tuple(g.key for g in gpu_meshes)
+        if self._offset_key != key:
+            self._offset_value = OFFSET_FRACTION * float(np.linalg.norm(np.ptp(
+                scene_bounds([g.mesh for g in gpu_meshes]), axis=0)))
+            self._offset_key = key
+        return self._offset_value
 
     def _skipped(self, gpu_meshes, light: Light, homogeneous: np.ndarray,
                  offset: float) -> list[bool]:
@@ -201,6 +212,7 @@ class ShadowVolumes:
         self._cache.clear()
         self._skips.clear()
         self._grouping.clear()
+        self._offset_key = None
         self._closed.clear()
 
     def drop_lights_from(self, count: int) -> None:
@@ -209,11 +221,14 @@ class ShadowVolumes:
 
     # ------------------------------------------------------------ passes
     def count(self, target, view, volumes: list[CasterVolume], method: str,
-              field: int = 0xFF) -> None:
+              field: int = 0xFF, clear: bool = True) -> None:
         """Stencil pass: clear the stencil and count volume faces (z-fail or z-pass).
 
         ``field`` limits the clear and the count to those stencil bits (COUNTER_MASK: mod 16,
-        leaving the transparent casters' flags alone)."""
+        leaving the transparent casters' flags alone). ``clear`` False: the caller knows the
+        stencil is still 0 from the frame's clear (the first light's count), and the
+        stencil-only clear (a masked read-modify-write of the packed depth-stencil buffer on
+        llvmpipe) is skipped."""
         GL = _gl()
         ctx = self.ctx
         _ = ctx.error
@@ -222,8 +237,9 @@ class ShadowVolumes:
         target.fbo.use()  # applies the masks (moderngl sets them on use)
         _ = ctx.error
         GL.glStencilMask(field)
-        GL.glClearStencil(0)
-        GL.glClear(GL.GL_STENCIL_BUFFER_BIT)
+        if clear:
+            GL.glClearStencil(0)
+            GL.glClear(GL.GL_STENCIL_BUFFER_BIT)
         ctx.enable_only(moderngl.DEPTH_TEST)
         ctx.depth_func = "<"
         GL.glEnable(GL.GL_STENCIL_TEST)
