@@ -43,6 +43,8 @@ def test_the_stage_through_a_whole_lesson(bigdisplay, tmp_path, name):
     width, height = SIZES[name]
     assert r["display"] == [width, height]
     assert r["errors"] == [""] * len(steps)
+    # no dock window over the stage: neither a tab focused at start nor a step's focus
+    assert r["visible"] == [[]] * len(steps), r["visible"]
     # the viewport is the stage: image + caption band >= 75 % of the window, at every step
     assert len(r["shares"]) == len(steps)
     assert min(r["shares"]) >= SHARE, r["shares"]
@@ -145,7 +147,7 @@ def _walk(ctx, state, out: dict) -> None:
     out["display"] = [width, height]
     steps = len(state.walk.lesson.lesson.steps)
     keys = ("shares", "image_shares", "viewport_sizes", "bands", "strips", "caption_px",
-            "glyphs", "strip_paths", "strip_widgets", "errors")
+            "glyphs", "strip_paths", "strip_widgets", "errors", "visible")
     rec = {k: [] for k in keys}
     for i in range(steps):
         if i:
@@ -164,6 +166,8 @@ def _walk(ctx, state, out: dict) -> None:
         rec["strip_paths"].append([p for p, _, _ in stage.drawn_controls])
         rec["strip_widgets"].append([w for _, w, _ in stage.drawn_controls])
         rec["errors"].append(state.error)
+        windows = hello_imgui.get_runner_params().docking_params.dockable_windows
+        rec["visible"].append(sorted(w.label for w in windows if w.is_visible))
         if i == SPECULAR_STEP:
             state.probe.pixel, state.probe.requested = _probe_pixel(state), True
             ctx.yield_(4)

@@ -3,6 +3,7 @@ flags that point nowhere, and a typed nan / inf in a slider leaves no traceback.
 
 from __future__ import annotations
 
+import json
 import shutil
 
 import pytest
@@ -97,6 +98,18 @@ def test_a_job_started_with_its_panel_hidden_ends_and_the_viewer_exits(shadelab,
              "3", "--window", window, "--screenshot", str(shot), *extra, code=0, xvfb=True,
              timeout=400)
     assert shot.is_file()
+
+
+@needs_xvfb
+@pytest.mark.gui
+def test_a_lesson_started_on_stage_shows_no_dock_window(shadelab, tmp_path):
+    """`--lesson --presenter` opens on the stage: the tabs focused at start (Scene, Equation)
+    and the step's focus panel stayed visible and drew over the stage's viewport."""
+    report = tmp_path / "bench.json"
+    shadelab("view", "--lesson", "phong-to-radiosity", "--step", "4", "--presenter",
+             "--fresh", "--no-autosave", "--frames", "12", "--window", "1024x768",
+             "--bench-json", str(report), code=0, xvfb=True, timeout=180)
+    assert json.loads(report.read_text())["panels_visible"] == []
 
 
 @needs_xvfb

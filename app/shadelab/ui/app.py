@@ -237,7 +237,8 @@ class Viewer:
             self.recorder.write(self.options.bench_json, self.options.window_size,
                                 pipelines.bench_report(self.state)  # jobs: first_image_s...
                                 | self.followups.bench_extra()
-                                | {"triangles": self.triangles()})
+                                | {"triangles": self.triangles(),
+                                   "panels_visible": visible_panels()})
         if self.gpu is not None:
             self.gpu.release()
             self.gpu = None
@@ -558,6 +559,15 @@ def _docking(viewer: Viewer) -> hello_imgui.DockingParams:
     params.dockable_windows[0].focus_window_at_next_frame = True
     params.dockable_windows[5].focus_window_at_next_frame = True  # the right column's first tab
     return params
+
+
+def visible_panels() -> list[str]:
+    """The dock windows shown now (none on the stage: presenter mode with the panels hidden)."""
+    try:
+        windows = hello_imgui.get_runner_params().docking_params.dockable_windows
+    except RuntimeError:      # no runner (a test without a window)
+        return []
+    return sorted(w.label for w in windows if w.is_visible)
 
 
 def clear_with_window_bg(params: hello_imgui.RunnerParams | None = None) -> None:

@@ -118,10 +118,14 @@ def apply_panel_visibility(state: AppState) -> None:
     """Tab: every dock window hidden (the viewport is drawn in a window of its own)."""
     global _hidden_labels
     windows = hello_imgui.get_runner_params().docking_params.dockable_windows
-    if state.view.hide_panels and not _hidden_labels:
-        _hidden_labels = [w.label for w in windows if w.is_visible]
+    if state.view.hide_panels:
+        # every frame: a window hello_imgui shows again (a tab focused at start, a lesson
+        # step's focus) would otherwise be drawn over the stage
         for w in windows:
-            w.is_visible = False
+            if w.is_visible:
+                if w.label not in _hidden_labels:
+                    _hidden_labels.append(w.label)
+                w.is_visible = False
     elif not state.view.hide_panels and _hidden_labels:
         for w in windows:
             if w.label in _hidden_labels:
