@@ -82,3 +82,28 @@ def test_a_worker_that_dies_is_restarted_by_the_next_job():
     finally:
         runner.shutdown()
     assert runner.worker.process is None
+
+
+def test_each_level_step_streams_before_the_next_one_is_computed():
+    """The step that completes the first full-resolution pass is handed on at once (it used
+    to wait for the next chunk); the last step comes again, marked done, with its image."""
+    from shadelab.pipelines.progressive import held_back
+
+    made = []
+
+    def steps():
+        for i in range(4):
+            made.append(i)
+            yield Progress(np.full((2, 2, 3), i, np.float32), (i + 1) / 4, f"step {i}",
+                           {"level": 1})
+
+    out = held_back(steps())
+    for i in range(4):
+        step = next(out)
+        assert step.message == f"step {i}" and len(made) == i + 1   # nothing computed ahead
+        assert not step.stats.get("done")
+    final = next(out)
+    assert final.stats["done"] and final.fraction == 1.0 and final.message == "done: step 3"
+    np.testing.assert_array_equal(final.image, np.full((2, 2, 3), 3, np.float32))
+    assert list(out) == []
+    assert list(held_back(iter(()))) == []
