@@ -35,19 +35,24 @@ TRAIL_MAX = 4096   # Progress entries a job keeps in its trail (a test and the l
 
 
 def _picklable(step: Progress) -> Progress:
-    """The Progress itself, or a copy without the stats entries that cannot cross processes."""
+    """The Progress itself, or a copy without the stats entries that cannot cross processes.
+
+    Only the small parts are test-pickled (message, fraction, stats): the image, a numpy array
+    (~11 MB at full viewport size), is pickled once, by the queue that sends it."""
+    image = step.image
     try:
-        pickle.dumps(step)
+        pickle.dumps((step.fraction, step.message, step.stats,
+                      None if image is None or type(image) is np.ndarray else image))
         return step
     except Exception:
         stats = {}
-        for key, value in step.stats.items():
+        for key, value in (step.stats or {}).items():
             try:
                 pickle.dumps(value)
                 stats[key] = value
             except Exception:
                 stats[key] = f"<{type(value).__name__}>"
-        return Progress(step.image, step.fraction, step.message, stats)
+        return Progress(image, step.fraction, step.message, stats)
 
 
 def _process_main(tasks, results, cancel, parent: int | None = None,
@@ -91,6 +96,8 @@ def _process_main(tasks, results, cancel, parent: int | None = None,
 class WorkerProcess:
     """One long-lived spawned process that runs jobs one at a time (started on first use)."""
 
+    spawns = 0   # processes started, every WorkerProcess together (a test counts them)
+
     def __init__(self) -> None:
         self._mp = multiprocessing.get_context("spawn")
         self.process = None
@@ -113,6 +120,7 @@ class WorkerProcess:
             main.__spec__ = None
             main.__dict__.pop("__file__", None)
             self.process.start()
+            WorkerProcess.spawns += 1
         finally:
             main.__dict__.update(saved)
 

@@ -1,10 +1,10 @@
 """The generic coarse-to-fine wrapper: any image pipeline at 1/8, 1/4, 1/2, then full size.
 
-Each level is a complete picture; the viewer shows it while the next one renders. The last
-step is held back and marked done (``stats["done"]``), so the newest Progress the viewer polls
-always carries the final image. A pipeline tunes its levels with ``level_state`` (shared by
-every level), ``level_options`` (per level, e.g. one sample until full size), ``unit`` and
-``work_done`` (what the status line counts).
+Each level is a complete picture; the viewer shows it while the next one renders. Each step
+streams at once, and the last one comes again marked done (``stats["done"]``), so the newest
+Progress the viewer polls always carries the final image. A pipeline tunes its levels with
+``level_state`` (shared by every level), ``level_options`` (per level, e.g. one sample until
+full size), ``unit`` and ``work_done`` (what the status line counts).
 """
 
 from __future__ import annotations
@@ -22,17 +22,17 @@ def level_size(size: tuple[int, int], divisor: int) -> tuple[int, int]:
 
 
 def held_back(steps: Iterator[Progress]) -> Iterator[Progress]:
-    """Yield every step but the last one late, marked done: the viewer polls only the newest
-    Progress, so the final one must carry the final image (not a bare 'done')."""
+    """Yield every step as soon as it exists (the first full-resolution pass streams the
+    moment its last tile is traced, not one chunk later), then the last one again, marked
+    done: the viewer polls only the newest Progress, so the final one must carry the final
+    image (not a bare 'done'). The done copy shares the last step's image."""
     last = None
     for step in steps:
-        if last is not None:
-            yield last
+        yield step
         last = step
     if last is not None:
-        last.fraction, last.stats = 1.0, dict(last.stats, done=True)
-        last.message = "done: " + last.message
-        yield last
+        yield Progress(last.image, 1.0, "done: " + last.message,
+                       dict(last.stats or {}, done=True))
 
 
 def progressive(pipeline, scene: Scene, size: tuple[int, int],
