@@ -7,7 +7,14 @@ import json
 
 import pytest
 
-from shadelab.lab.recorder import IDLE, INTERACTIVE, REDRAW, WARM_UP_FRAMES, FrameRecorder
+from shadelab.lab.recorder import (
+    IDLE,
+    INTERACTIVE,
+    REDRAW,
+    SETTLING,
+    WARM_UP_FRAMES,
+    FrameRecorder,
+)
 
 
 def test_bench_phases_split_the_frames_in_thirds():
@@ -117,3 +124,26 @@ def test_breakdown_is_off_outside_the_bench():
     rec.end("gui")
     rec.frame_swapped()
     assert rec.part_cpu == [] and "idle_breakdown" not in rec.report((640, 480))
+
+
+def test_settling_frames_are_in_no_phase_and_the_settle_time_is_reported(tmp_path):
+    """The bench's frames before the viewer settled (the start-up warm-up on the other core)
+    time the warm-up: they must not enter the idle median."""
+    rec = FrameRecorder(viewport_shown=True)
+    n = WARM_UP_FRAMES + 4
+    rec.settling = True
+    for _ in range(n):
+        rec.frame_swapped()
+    rec.settling = False
+    rec.settled = rec.first_frame + 2.5
+    for _ in range(n):
+        rec.frame_swapped()
+    assert rec.redraw_flags == [SETTLING] * n + [IDLE] * n
+    # settling frames last 100 ms, the settled idle ones 10 ms
+    rec.frame_times = [0.1 * i for i in range(n)] + [0.1 * (n - 1) + 0.01 * (i + 1)
+                                                      for i in range(n)]
+    path = tmp_path / "viewer.json"
+    rec.write(str(path), (1280, 720), {})
+    report = json.loads(path.read_text())
+    assert report["idle_frame_ms_median"] == pytest.approx(10.0)
+    assert report["settled_after_first_frame_s"] == pytest.approx(2.5)

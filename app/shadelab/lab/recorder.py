@@ -27,7 +27,9 @@ import numpy as np
 
 WARM_UP_FRAMES = 5  # skipped in each phase's figures
 
-IDLE, REDRAW, INTERACTIVE = 0, 1, 2  # what a frame did: GUI only, full redraw, drag redraw
+# what a frame did: GUI only, full redraw, drag redraw; SETTLING: before the bench's phases (the
+# start-up warm-up still running on the other core), in no phase's figures
+SETTLING, IDLE, REDRAW, INTERACTIVE = -1, 0, 1, 2
 PHASES = (("idle", IDLE), ("redraw", REDRAW), ("interactive", INTERACTIVE))
 # The parts of a frame's CPU time (the Viewer's hooks): the panels and dock windows built in
 # Python (ImGui calls), the viewport's scene passes (the Renderer, overlays, display pass), the
@@ -49,6 +51,8 @@ class FrameRecorder:
     redrawn: bool = False              # this frame re-rendered the scene
     viewport_shown: bool = False       # the viewport window has drawn (first_frame counts)
     breakdown: bool = False            # time the parts of each frame (the bench)
+    settling: bool = False             # the bench's phases have not started (warm-up running)
+    settled: float = 0.0               # perf_counter when they started (0: not the bench)
     part_cpu: list = field(default_factory=list)    # per frame: {part: main-thread CPU s}
     part_wall: list = field(default_factory=list)   # per frame: {part: wall s}
     _open: list = field(default_factory=list)       # [name, cpu0, wall0, child cpu, child wall]
@@ -107,6 +111,7 @@ class FrameRecorder:
         self.frame_times.append(now)
         self.cpu_times.append(time.process_time())
         flag = IDLE if not self.redrawn else (INTERACTIVE if self.force_interactive else REDRAW)
+        flag = SETTLING if self.settling else flag
         self.redraw_flags.append(flag)
         self.redrawn = False
         if self.breakdown:
@@ -122,6 +127,8 @@ class FrameRecorder:
         report = {"first_frame_s": self.first_frame_since_start(),
                   "first_frame_cpu_s": self.first_frame_cpu,
                   "frames": len(self.frame_times), "window": list(window_size)}
+        if self.settled and self.first_frame:   # the bench's phases began this long after
+            report["settled_after_first_frame_s"] = max(self.settled - self.first_frame, 0.0)
         cpu = np.diff(np.asarray(self.cpu_times)) * 1000.0
         for name, flag in PHASES:
             select = flags == flag

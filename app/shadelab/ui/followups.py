@@ -148,13 +148,15 @@ class FollowUps:
     def bench_extra(self) -> dict:
         return {} if self.page_down_s is None else {"page_down_s": self.page_down_s}
 
-    def end_frame(self, state: AppState) -> bool:
-        """Once a frame: the after-job requests; True when ``--frames`` says quit now."""
+    def end_frame(self, state: AppState, frame0: int = 0) -> bool:
+        """Once a frame: the after-job requests; True when ``--frames`` says quit now
+        (``--frames`` frames after ``frame0``: the bench counts from a settled viewer)."""
         waiting = self.waiting(state)
         if self.options.job and not waiting and not self.job_followed_up:
             self.job_followed_up = True
             self.follow_up_job(state)
-        return bool(self.options.frames) and state.frame >= self.options.frames and not waiting
+        return bool(self.options.frames) and state.frame - frame0 >= self.options.frames \
+            and not waiting
 
     def follow_up_job(self, state: AppState) -> None:
         """The command line's after-job requests: radiosity in the viewport, a ray tree."""

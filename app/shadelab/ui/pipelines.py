@@ -329,6 +329,14 @@ def busy(state: AppState) -> bool:
     return view.wanted is not None or view.runner.running or view.version < 0
 
 
+def warming(state: AppState) -> bool:
+    """The start-up warm-up job (the worker process importing and loading the offline
+    kernels, on the other core) has not finished yet."""
+    view = state.view.pipeline_view
+    return view is not None and view.name == "warm-up" and view.runner is not None \
+        and (view.runner.running or not view.runner.started)
+
+
 def warm(state: AppState) -> None:
     """Compile or load the offline kernels in the pipeline worker (viewer start-up)."""
     view = view_of(state)
