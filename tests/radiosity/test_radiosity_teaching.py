@@ -161,3 +161,27 @@ def test_display_plan_equals_display_meshes(split):
         np.testing.assert_array_equal(f0, f1)
         np.testing.assert_allclose(v0, v1, rtol=0, atol=1e-12)
         np.testing.assert_allclose(c0, c1, rtol=1e-12, atol=1e-12)
+
+
+def test_first_lit_image_comes_before_the_form_factor_matrix():
+    """The lesson's first lit image waits for one row, not all of F: the job's first Progress
+    after meshing is the first shot (a preview, before any form-factor progress), and the
+    solve that follows, once F is known, shoots that same first shot (Cornell's light is the
+    smaller patch of every pair, so the reciprocal matrix's row is the row integrated over it:
+    the same B to rounding)."""
+    scene = _cornell()
+    pipeline._RADIOSITY_CACHE.clear()
+    seen = list(pipeline.pipeline_radiosity(scene, None, step_shots=1))
+    assert seen[0].message == "meshing"
+    preview = seen[1]
+    assert preview.stats["preview"] is True and preview.stats["shots"] == 1
+    assert len(preview.stats["soup"]) > 0 and preview.stats["soup"][:, 3:].max() > 0
+    later = [p.message for p in seen[2:]]
+    assert any(m.startswith("form factors") for m in later)   # F is computed after it
+    solved = next(p for p in seen[2:] if p.stats.get("shots") == 1)
+    assert "preview" not in solved.stats
+    assert solved.stats["shooter_index"] == preview.stats["shooter_index"]
+    np.testing.assert_allclose(preview.stats["B"], solved.stats["B"], rtol=1e-12, atol=1e-12)
+    # a second job on the same geometry knows F already: no preview
+    again = list(pipeline.pipeline_radiosity(scene, None, step_shots=1))
+    assert not any(p.stats.get("preview") for p in again)
