@@ -660,6 +660,20 @@ def runner_params(viewer: Viewer) -> hello_imgui.RunnerParams:
     return params
 
 
+def native_run(params, addons) -> None:
+    """immapp's native runner. imgui-bundle wraps ``immapp.run`` with a tutorial helper that
+    calls ``inspect.stack()`` (it reads the source of every frame on the stack: ~0.1 s of the
+    ~1 s to the first frame) to decide whether to save a tutorial screenshot; in a notebook
+    the wrapper also shows the final frame, so there it is kept."""
+    import sys
+
+    native = getattr(getattr(immapp, "immapp_cpp", None), "run", None)
+    if native is None or "ipykernel" in sys.modules:
+        immapp.run(params, addons)
+    else:
+        native(params, addons)
+
+
 _running: list[Viewer] = []  # the viewer of this process's window while it runs
 
 
@@ -695,7 +709,7 @@ def _run(viewer: Viewer, state: AppState, options: ViewerOptions) -> int:
         testing.run(test_function=lambda ctx: options.test_function(ctx, state),
                     runner_params=params, add_ons_params=addons)
     else:
-        immapp.run(params, addons)
+        native_run(params, addons)
     if options.screenshot:
         write_window_screenshot(options.screenshot)
     return 0
