@@ -107,3 +107,32 @@ def test_each_level_step_streams_before_the_next_one_is_computed():
     np.testing.assert_array_equal(final.image, np.full((2, 2, 3), 3, np.float32))
     assert list(out) == []
     assert list(held_back(iter(()))) == []
+
+
+def test_a_process_jobs_last_image_is_prepared_off_the_ui_thread():
+    """``JobRunner.prepare`` runs in the listener thread (the viewer converts each image to
+    sRGB there, not on the UI thread): when the job has ended, ``prepared`` holds the
+    conversion of its last image, with that Progress's version, stats and message."""
+    from shadelab.shading.conventions import to_srgb8
+    from shadelab.ui.pipelines import SrgbOffThread
+
+    scene = load_preset("cornell")
+    runner = JobRunner()
+    convert = SrgbOffThread()
+    convert.exposure = 0.5
+    runner.prepare = convert
+    try:
+        runner.start("ref", lambda: None, call=(iter_reference_raster, scene, SIZE))
+        assert runner.in_process
+        runner._thread.join(120.0)
+        assert not runner.running and not runner.error
+        last, version = runner.snapshot()
+        seen_version, (exposure, rgba, image), stats, message = runner.prepared
+        assert seen_version == version and stats is last.stats and message == last.message
+        assert exposure == 0.5 and image.shape == (SIZE[1], SIZE[0], 3)
+        np.testing.assert_array_equal(image, last.image)
+        assert rgba.shape == (SIZE[1], SIZE[0], 4) and rgba.flags.c_contiguous
+        np.testing.assert_array_equal(rgba[..., :3], to_srgb8(last.image, 0.5)[::-1])
+        assert (rgba[..., 3] == 255).all()
+    finally:
+        runner.shutdown()

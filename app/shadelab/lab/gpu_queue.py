@@ -43,11 +43,11 @@ class GpuQueue:
     errors: dict[str, str] = field(default_factory=dict)           # key -> a request's error
 
     def upload(self, key: str, image: np.ndarray) -> None:
-        """Show ``image`` ((H, W, 3) uint8, row 0 at the top) as texture ``key`` (replaces
-        what waits under that key)."""
+        """Show ``image`` ((H, W, 3) uint8, or (H, W, 4) with its alpha, row 0 at the top) as
+        texture ``key`` (replaces what waits under that key)."""
         image = np.asarray(image)
-        if image.ndim != 3 or image.shape[2] != 3 or image.dtype != np.uint8:
-            raise ValueError(f"upload '{key}': expected (H, W, 3) uint8, got "
+        if image.ndim != 3 or image.shape[2] not in (3, 4) or image.dtype != np.uint8:
+            raise ValueError(f"upload '{key}': expected (H, W, 3) or (H, W, 4) uint8, got "
                              f"{image.shape} {image.dtype}")
         self.uploads[key] = np.ascontiguousarray(image)
 

@@ -31,6 +31,7 @@ from shadelab.scene.preset import clone_scene
 
 JobFactory = Callable[[Scene, tuple[int, int]], Iterator[Progress]]
 KILL_AFTER = 3.0   # seconds a cancelled process job may take before its process is ended
+PREPARE_EVERY_S = 0.25   # while images keep coming, the newest is prepared this often
 TRAIL_MAX = 4096   # Progress entries a job keeps in its trail (a test and the log read it)
 
 
@@ -174,6 +175,11 @@ class JobRunner:
         self.trail: list[dict] = []     # every Progress of the job, in brief (the UI may skip some)
         self.rows: dict = {}            # rows of a matrix the job sends in pieces, every piece
         #                                 kept (stats["ff_rows"]: radiosity's form factors)
+        # the UI's per-image work, done in the listener thread for the newest image (numpy
+        # frees the GIL: the UI thread keeps drawing): (version, value, stats, message)
+        self.prepare: Callable[[Progress], object] | None = None
+        self.prepared: tuple | None = None
+        self._prepared_at = 0.0
         self._cancel = threading.Event()
         self._thread: threading.Thread | None = None
         self._lock = threading.Lock()
@@ -198,7 +204,7 @@ class JobRunner:
         """
         self.cancel(wait=True)
         self.name, self.latest, self.error, self.cancelled = name, None, "", False
-        self.trail, self.rows = [], {}
+        self.trail, self.rows, self.prepared = [], {}, None
         self.started, self.finished = time.perf_counter(), 0.0
         self._cancel.clear()
         self._job_id += 1
@@ -263,10 +269,33 @@ class JobRunner:
             if message[0] == "progress":
                 with self._lock:
                     self._publish(message[2])
+                # the newest image once the queue is drained (or every PREPARE_EVERY_S while
+                # images keep coming): never a backlog of conversions behind the worker
+                if self.prepare is not None and (
+                        worker.results.empty()
+                        or time.perf_counter() - self._prepared_at > PREPARE_EVERY_S):
+                    self._prepare_latest()
             else:
                 self.error, self.cancelled = message[2], message[3]
                 break
+        if self.prepare is not None:   # the last image, whatever the queue held after it
+            self._prepare_latest()
         self.finished = time.perf_counter()
+
+    def _prepare_latest(self) -> None:
+        """``prepare`` the newest Progress's image, outside the lock; ``prepared`` then holds
+        (its version, the result, its stats, its message)."""
+        with self._lock:
+            step, version = self.latest, self.version
+        if step is None or step.image is None or (
+                self.prepared is not None and self.prepared[0] == version):
+            return
+        self._prepared_at = time.perf_counter()
+        try:
+            value = self.prepare(step)
+        except Exception:   # the UI thread converts it instead
+            return
+        self.prepared = (version, value, step.stats or {}, step.message)
 
     def _work(self, make: Callable[[], Iterator[Progress]]) -> None:
         gen = None

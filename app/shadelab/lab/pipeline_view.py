@@ -32,6 +32,7 @@ class PipelineView:
     job_scene: object = None
     job_size: tuple = (0, 0)
     version: int = -1
+    image_version: int = -1              # the runner's version of the image shown
     image_size: tuple = (0, 0)           # the latest image's (w, h) (coarse levels: smaller)
     soup: np.ndarray | None = None
     shooter: np.ndarray | None = None

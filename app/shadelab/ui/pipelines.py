@@ -162,7 +162,7 @@ def _adopt_prefetch(state: AppState, name: str, size) -> bool:
         view.record.done_s = since_start(old.finished or time.perf_counter())
     view.runner, view.wanted = runner, None
     view.name, view.job_scene, view.job_size = name, scene, job_size
-    view.version = -1
+    view.version = view.image_version = -1
     view.record = JobRecord(f"viewport {name}", tuple(size), since_start(time.perf_counter()),
                             prefetched=True)
     view.log.append(view.record)
@@ -212,6 +212,7 @@ def _start_prefetch(state: AppState, pf, index: int, name: str, size) -> None:
         scene.raytrace.spp = max(int(state.offline.spp), 1)
     if pf.runner is None:
         pf.runner = JobRunner()
+    pf.runner.prepare = SRGB_OFF_THREAD
     pf.scene, pf.size = scene, tuple(size)
     factory = OFFLINE[name]
     pf.record = JobRecord(f"prefetch {name} (step {index + 1})", tuple(size),
@@ -226,7 +227,7 @@ def _start(state: AppState, name: str, scene, size) -> None:
     if view.record is not None and view.record.done_s is None:
         view.record.done_s = since_start(view.runner.finished or time.perf_counter())
     view.name, view.job_scene, view.job_size = name, scene, size
-    view.version = -1
+    view.version = view.image_version = -1
     view.record = JobRecord(f"viewport {name}", tuple(size), since_start(time.perf_counter()))
     view.log.append(view.record)
     view.stats = {}
@@ -262,45 +263,102 @@ class _StepGate:
             yield item
 
 
-def _take(state: AppState) -> None:
-    view = view_of(state)
-    latest, version = view.runner.snapshot()
-    record = view.record
-    if record is not None and record.done_s is None and view.runner.started \
-            and not view.runner.running:   # (an adopted prefetch may have finished before)
-        record.done_s = max(record.started_s,
-                            since_start(view.runner.finished or time.perf_counter()))
-    if latest is None or version == view.version:
-        return
-    view.version = version
-    view.message = latest.message
-    stats = latest.stats or {}
+class SrgbOffThread:
+    """The display conversion of a job's images (exposure, clip, sRGB, bottom-up RGBA) in
+    the job runner's listener thread, for the newest image only (``JobRunner.prepare``):
+    on the UI thread ``to_srgb8`` of a 1920x858 path-traced image took ~0.2 s per update,
+    and the viewer drew 5 fps while the path tracer refined. ``exposure``: the viewer's,
+    written by the UI thread every frame; each result names the exposure it used."""
+
+    exposure = 1.0
+
+    def __call__(self, step) -> tuple:
+        from shadelab.shading.conventions import to_srgb8
+
+        exposure = self.exposure
+        image = np.asarray(step.image, np.float32)
+        h, w = image.shape[:2]
+        rgba = np.empty((h, w, 4), np.uint8)   # the texture's own layout: no copy on upload
+        rgba[..., :3], rgba[..., 3] = to_srgb8(image, exposure)[::-1], 255
+        return exposure, rgba, image
+
+
+SRGB_OFF_THREAD = SrgbOffThread()
+
+
+def _show_image(state: AppState, view, image: np.ndarray, srgb_bottom_up=None) -> None:
+    """Upload the display of a linear image (bottom-up sRGB rows, RGB or RGBA; converted here
+    when not given)."""
+    if srgb_bottom_up is None:
+        from shadelab.shading.conventions import to_srgb8
+
+        srgb_bottom_up = to_srgb8(image, state.scene.render.exposure)[::-1]
+    state.gpu.upload("pipeline", srgb_bottom_up)
+    view.image_size = (image.shape[1], image.shape[0])
+    view.linear = image
+
+
+def _take_words(view, message: str, stats: dict) -> None:
+    view.message = message
     view.stats = {k: v for k, v in stats.items() if k not in ("soup", "history")} \
         | ({"gate": view.stats["gate"]} if "gate" in view.stats else {})
     if "history" in stats:
         view.history = stats["history"]
-    got_image = False
-    if latest.image is not None:
-        from shadelab.shading.conventions import to_srgb8
 
-        image = np.asarray(latest.image, np.float32)
-        srgb = to_srgb8(image, state.scene.render.exposure)
-        state.gpu.upload("pipeline", srgb[::-1])  # bottom-up
-        view.image_size = (image.shape[1], image.shape[0])
-        view.linear = image
-        got_image = True
-    if "soup" in stats:
-        view.soup = stats["soup"]
-        view.shooter = stats.get("shooter")
-        got_image = True
+
+def _take(state: AppState) -> None:
+    """The job's newest Progress into the view. A process job's images come converted by
+    the runner's listener thread (:class:`SrgbOffThread`), each with its own Progress's
+    words, so the view never says "done" over an older image; a thread job's (and a
+    Progress without an image: radiosity's triangles, meshing) are taken here."""
+    view = view_of(state)
+    runner = view.runner
+    if getattr(runner, "prepare", False) is None:   # a JobRunner (tests pass stand-ins)
+        runner.prepare = SRGB_OFF_THREAD
+    SRGB_OFF_THREAD.exposure = float(state.scene.render.exposure)
+    latest, version = runner.snapshot()
+    record = view.record
+    if record is not None and record.done_s is None and runner.started \
+            and not runner.running:   # (an adopted prefetch may have finished before)
+        record.done_s = max(record.started_s,
+                            since_start(runner.finished or time.perf_counter()))
+    off_thread = getattr(runner, "prepare", None) is not None \
+        and getattr(runner, "in_process", False)
+    got_image, image_stats, taken = False, {}, {}
+    prepared = getattr(runner, "prepared", None) if off_thread else None
+    if prepared is not None and prepared[0] > view.image_version:
+        version_p, (exposure, rgba, image), stats_p, message_p = prepared
+        view.image_version = version_p
+        # converted again here only if the exposure changed since
+        _show_image(state, view, image, rgba if exposure == state.scene.render.exposure
+                    else None)
+        got_image, image_stats = True, stats_p
+        if version_p > view.version:
+            view.version = version_p
+            _take_words(view, message_p, stats_p)
+            taken = stats_p
+    if latest is not None and version > view.version \
+            and not (off_thread and latest.image is not None):
+        view.version = version
+        stats = taken = latest.stats or {}
+        _take_words(view, latest.message, stats)
+        if latest.image is not None:   # a thread job's image
+            _show_image(state, view, np.asarray(latest.image, np.float32))
+            view.image_version = version
+            got_image, image_stats = True, stats
+        if "soup" in stats:
+            view.soup = stats["soup"]
+            view.shooter = stats.get("shooter")
+            got_image, image_stats = True, stats
+    stats = image_stats
     if record is not None and got_image and record.first_image_s is None:
         record.first_image_s = since_start(time.perf_counter())
     if record is not None and got_image and record.first_full_s is None \
             and stats.get("level") == 1 and "size" in stats \
             and stats.get("level_work", 0) >= stats["size"][0] * stats["size"][1]:
         record.first_full_s = since_start(time.perf_counter())
-    if record is not None and "form_factors_reused" in stats:
-        record.reused_form_factors = bool(stats["form_factors_reused"])
+    if record is not None and "form_factors_reused" in taken:
+        record.reused_form_factors = bool(taken["form_factors_reused"])
 
 
 def track_side_panel_job(state: AppState) -> None:

@@ -200,10 +200,14 @@ class Viewport:
         return np.ascontiguousarray(data[::-1, :, :3])
 
     def upload_image(self, key: str, image_srgb8: np.ndarray) -> moderngl.Texture:
-        """A texture holding an (H, W, 3) uint8 image (row 0 at the top) for imgui.image."""
+        """A texture holding an (H, W, 3) uint8 image, or (H, W, 4) with its alpha (row 0 at
+        the top), for imgui.image."""
         h, w = image_srgb8.shape[:2]
-        rgba = np.empty((h, w, 4), np.uint8)
-        rgba[..., :3], rgba[..., 3] = image_srgb8, 255
+        if image_srgb8.shape[2] == 4 and image_srgb8.flags.c_contiguous:
+            rgba = image_srgb8
+        else:
+            rgba = np.empty((h, w, 4), np.uint8)
+            rgba[..., :3], rgba[..., 3] = image_srgb8[..., :3], 255
         tex = self.images.get(key)
         if tex is None or tex.size != (w, h):
             if tex is not None:
@@ -211,7 +215,7 @@ class Viewport:
             tex = self.ctx.texture((w, h), 4, dtype="f1")
             tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
             self.images[key] = tex
-        tex.write(rgba.tobytes())  # row 0 first: imgui's default uv puts it on top
+        tex.write(memoryview(rgba).cast("B"))  # row 0 first: imgui's uv puts it on top
         return tex
 
     def release(self) -> None:
