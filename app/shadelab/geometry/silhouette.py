@@ -381,3 +381,92 @@ def shadows_nothing(vertices: np.ndarray, face_normals: np.ndarray, light: np.nd
 
 
 _CORNER_PICK = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)])
+
+
+@dataclass
+class CountVolume:
+    """A silhouette volume with cheaper caps, for the stencil count only (the same counts as
+    the full volume wherever :meth:`ranges` says so; shown volumes keep their full caps).
+
+    The count at a point is the winding number of the volume's closed surface around it, a
+    sum over its faces that depends on a cap only through the cap's boundary (the silhouette
+    loops) and through the points that lie between the cap and its replacement:
+
+    * the far cap (the dark faces at infinity, w = 0) lies at depth 1 in every pixel (z = w
+      exactly with the infinite far plane): it is counted wherever it covers the pixel, and
+      only its coverage of the screen matters. A fan from one point at infinity over the
+      extruded silhouette edges has the same boundary; with every direction from the light
+      through the caster in one open hemisphere around the apex (the light outside the
+      caster's reach, :func:`count_volume` checks), fan and cap are the same chain on the
+      plane at infinity, and cover every pixel the same number of times;
+    * the near cap (the dark faces, turned) can become a fan from a point inside the caster
+      over the silhouette loops when the caster is convex: the fan lies inside the caster,
+      behind its lit faces from the light, and the counts change only between the fan and
+      the dark faces, inside the caster, where no visible surface lies while the eye is
+      outside the caster (the dark faces themselves count 1 either way: in shadow).
+
+    ``faces`` are [sides, far fan, near fan, near cap (the dark faces, turned)], into
+    ``vertices`` (the volume's, then the near apex (w = 1) and the far apex (w = 0)).
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    sides_and_far: int   # faces: the sides and the far fan
+    near_fan: int        # faces: the near fan (0 when the caster is not convex)
+    near_cap: int        # faces: the dark faces, turned
+
+    def ranges(self, eye_outside: bool) -> list[tuple[int, int]]:
+        """(first face, face count) to draw: the near fan only with the eye outside the
+        caster (its bounding box grown by the near plane's reach), else the near cap."""
+        if eye_outside and self.near_fan:
+            return [(0, self.sides_and_far + self.near_fan)]
+        if self.near_fan:
+            return [(0, self.sides_and_far),
+                    (self.sides_and_far + self.near_fan, self.near_cap)]
+        return [(0, self.sides_and_far + self.near_cap)]
+
+    def triangles(self) -> np.ndarray:
+        """(K, 3, 4) float32 triangle soup for the GPU."""
+        return self.vertices[self.faces].astype(np.float32)
+
+
+def count_volume(volume: ShadowVolume, light: np.ndarray, convex: bool) -> CountVolume | None:
+    """The :class:`CountVolume` of a silhouette volume (:func:`shadow_volume` of a closed
+    caster) for the homogeneous ``light``; ``convex``: the caster is convex (its near cap may
+    become a fan). None where the caps must stay (no silhouette, or directions from the light
+    through the caster that do not fit in an open hemisphere: a light inside or among it)."""
+    if volume.method != "silhouette" or len(volume.silhouette) == 0:
+        return None
+    v = volume.vertices
+    n = len(v) // 2
+    edges = volume.silhouette
+    e = len(edges)
+    d = (len(volume.faces) - 2 * e) // 2
+    sides = volume.faces[: 2 * e]
+    near_cap = volume.faces[2 * e: 2 * e + d]
+    directions = v[n:, :3]
+    mean = directions.sum(axis=0)
+    length = np.linalg.norm(mean)
+    if not length > 0.0:
+        return None
+    mean = mean / length
+    if light[3] != 0.0 and float((directions @ mean).min()) <= 1e-6:
+        return None            # not within an open hemisphere: keep the far cap
+    near_apex = v[np.unique(edges), :3].mean(axis=0)
+    vertices = np.concatenate([v, [[*near_apex, 1.0], [*mean, 0.0]]])
+    a, b = edges[:, 0], edges[:, 1]
+    far_fan = np.stack([np.full(e, 2 * n + 1), b + n, a + n], axis=1)
+    near_fan = np.stack([np.full(e, 2 * n), a, b], axis=1) if convex \
+        else np.zeros((0, 3), np.int64)
+    faces = np.concatenate([sides, far_fan, near_fan, near_cap]).astype(np.int64)
+    return CountVolume(vertices, faces, len(sides) + e, len(near_fan), len(near_cap))
+
+
+def is_convex(vertices: np.ndarray, faces: np.ndarray) -> bool:
+    """Is the closed caster (:func:`closed_caster`) convex (trimesh's test)?"""
+    import trimesh
+
+    mesh = closed_caster(vertices, faces)
+    if mesh is None:
+        return False
+    return bool(trimesh.Trimesh(mesh.vertices, mesh.faces, process=False).is_convex)

@@ -100,6 +100,9 @@ class View:
     clip_from_world: np.ndarray
     eye: np.ndarray
     size: tuple[int, int]
+    # how far from the eye the near plane reaches (:func:`near_reach`); inf: unknown, and
+    # nothing is taken to be seen from outside
+    near_reach: float = math.inf
 
 
 class ProgramUniforms:
@@ -130,7 +133,8 @@ def make_view(scene: Scene, size: tuple[int, int], meshes: list[MeshData],
         bounds = scene_bounds(meshes)
     far = math.inf if infinite_far else far_plane(scene.camera, bounds)
     eye = np.asarray(scene.camera.eye, dtype=np.float64)
-    return View(clip_from_world(scene.camera, aspect, far), eye, size)
+    return View(clip_from_world(scene.camera, aspect, far), eye, size,
+                near_reach(scene, size))
 
 
 class Renderer:

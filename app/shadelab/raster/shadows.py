@@ -19,8 +19,11 @@ import numpy as np
 
 from shadelab.geometry.mesh import scene_bounds
 from shadelab.geometry.silhouette import (
+    CountVolume,
     ShadowVolume,
     closed_caster,
+    count_volume,
+    is_convex,
     open_caster_groups,
     open_volume,
     shadow_volume,
@@ -42,6 +45,9 @@ HEAT_LEVELS = 8  # stencil counts 1..8 get their own color; above 8 shows as 8
 # (mod 16) and one "inside caster j's volume" flag per transparent caster (bits 4..7)
 COUNTER_MASK = 0x0F
 FILTER_SLOTS = 4  # transparent casters filtered per light; further ones cast no shadow
+# The stencil count draws closed casters' volumes with fans for caps where the counts are the
+# same (silhouette.CountVolume); False counts with the full caps (A/B measurements, tests)
+REDUCED_CAPS = True
 
 
 def filter_bit(slot: int) -> int:
@@ -76,10 +82,36 @@ class CasterVolume:
     vao: moderngl.VertexArray
     line_vbo: moderngl.Buffer
     line_vao: moderngl.VertexArray
+    # the cheaper caps of a closed caster's volume for the count (None: count with vao)
+    counted: CountVolume | None = None
+    count_vbo: moderngl.Buffer | None = None
+    count_vao: moderngl.VertexArray | None = None
+    bounds: np.ndarray | None = None  # the caster's (2, 3) world box (closed casters)
 
     def release(self) -> None:
-        for item in (self.vao, self.vbo, self.line_vao, self.line_vbo):
-            item.release()
+        for item in (self.vao, self.vbo, self.line_vao, self.line_vbo, self.count_vao,
+                     self.count_vbo):
+            if item is not None:
+                item.release()
+
+    def render_count(self, view) -> None:
+        """Draw the volume for the stencil count: its :class:`CountVolume` where there is
+        one (the near fan only with the eye outside the caster), else every face."""
+        if self.counted is None or not REDUCED_CAPS:
+            self.vao.render(moderngl.TRIANGLES)
+            return
+        for first, faces in self.counted.ranges(_eye_outside(view, self.bounds)):
+            self.count_vao.render(moderngl.TRIANGLES, vertices=3 * faces, first=3 * first)
+
+
+def _eye_outside(view, bounds: np.ndarray | None) -> bool:
+    """Is the view's eye farther from the box than the near plane reaches (View.near_reach;
+    a view without one counts as inside)?"""
+    reach = getattr(view, "near_reach", np.inf)
+    if bounds is None or not np.isfinite(reach):
+        return False
+    gap = np.maximum(np.maximum(bounds[0] - view.eye, view.eye - bounds[1]), 0.0)
+    return bool(np.linalg.norm(gap) > 1.01 * reach + 1e-9)
 
 
 class ShadowVolumes:
@@ -90,6 +122,7 @@ class ShadowVolumes:
         self.program = load_program(ctx, "shadow_volume")
         self._cache: dict[tuple, CasterVolume] = {}
         self._closed: dict[tuple, bool] = {}  # geometry key -> closed caster?
+        self._convex: dict[tuple, bool] = {}  # geometry key -> convex closed caster?
         self._grouping: dict[tuple, list[list[int]]] = {}  # recent groupings of open casters
         self._skips: dict[tuple, list[bool]] = {}  # recent shadows_nothing answers
         self._offset_key: tuple | None = None   # the meshes _offset_value was measured on
@@ -128,7 +161,10 @@ class ShadowVolumes:
             key = (gpu.key, light_key(light), offset)
             live.add(slot)
             out.append(self._cached(slot, key, gpu.mesh.index, lambda g=gpu: shadow_volume(
-                g.mesh.vertices, g.mesh.faces, homogeneous, offset)))
+                g.mesh.vertices, g.mesh.faces, homogeneous, offset),
+                counted=lambda volume, g=gpu: count_volume(volume, homogeneous,
+                                                           self._is_convex(g)),
+                bounds=gpu.bounds))
         for group in self._groups(grouped):
             members = [grouped[i] for i in group]
             slot = (("open",) + tuple(g.mesh.index for g in members), light_index)
@@ -166,13 +202,24 @@ class ShadowVolumes:
             self._skips[key] = skipped
         return skipped
 
-    def _cached(self, slot: tuple, key: tuple, object_index: int, build) -> CasterVolume:
-        """The volume in ``slot`` if it was built for ``key``, else ``build()`` uploaded."""
+    def _cached(self, slot: tuple, key: tuple, object_index: int, build, counted=None,
+                bounds: np.ndarray | None = None) -> CasterVolume:
+        """The volume in ``slot`` if it was built for ``key``, else ``build()`` uploaded
+        (with ``counted(volume)``, its :class:`CountVolume` or None, for a closed caster
+        whose world box is ``bounds``)."""
         cached = self._cache.get(slot)
         if cached is None or cached.key != key:
             if cached is not None:
                 cached.release()
-            cached = self._upload(key, object_index, build())
+            volume = build()
+            cached = self._upload(key, object_index, volume)
+            reduced = counted(volume) if counted is not None else None
+            if reduced is not None:
+                cached.counted = reduced
+                cached.count_vbo = self.ctx.buffer(reduced.triangles().tobytes())
+                cached.count_vao = self.ctx.vertex_array(
+                    self.program, [(cached.count_vbo, "4f", "in_position")])
+                cached.bounds = np.asarray(bounds, dtype=np.float64)
             self._cache[slot] = cached
         return cached
 
@@ -197,6 +244,16 @@ class ShadowVolumes:
             self._closed[gpu.key] = closed
         return closed
 
+    def _is_convex(self, gpu) -> bool:
+        """Is the object's mesh a convex closed caster? Memoized per geometry."""
+        convex = self._convex.get(gpu.key)
+        if convex is None:
+            convex = is_convex(gpu.mesh.vertices, gpu.mesh.faces)
+            if len(self._convex) > 256:
+                self._convex.clear()
+            self._convex[gpu.key] = convex
+        return convex
+
     def _upload(self, key: tuple, object_index: int, volume: ShadowVolume) -> CasterVolume:
         vbo = self.ctx.buffer(volume.triangles().tobytes())
         vao = self.ctx.vertex_array(self.program, [(vbo, "4f", "in_position")])
@@ -214,6 +271,7 @@ class ShadowVolumes:
         self._grouping.clear()
         self._offset_key = None
         self._closed.clear()
+        self._convex.clear()
 
     def drop_lights_from(self, count: int) -> None:
         for slot in [s for s in self._cache if s[1] >= count]:
@@ -255,7 +313,7 @@ class ShadowVolumes:
         set_uniform(self.program, "u_clip_from_world", gl_matrix(view.clip_from_world))
         set_uniform(self.program, "u_color", (0.0, 0.0, 0.0, 0.0))
         for caster in volumes:
-            caster.vao.render(moderngl.TRIANGLES)
+            caster.render_count(view)
         GL.glDisable(GL.GL_DEPTH_CLAMP)
         GL.glStencilOp(GL.GL_KEEP, GL.GL_KEEP, GL.GL_KEEP)
         target.fbo.color_mask = (True, True, True, True)
