@@ -560,7 +560,7 @@ class Renderer:
         culling = False
         try:
             if not terminator:  # no per-mesh uniform: one draw per run of one material
-                for run in _material_runs(gpu_meshes, culled):
+                for run in _cull_runs(_material_runs(gpu_meshes), culled):
                     culling = self._cull(id(run[0]) in culled, culling)
                     program_name = self.use_material(scene, run[0].mesh.material, shading)
                     self.vao(self._batch(run), program_name).render(moderngl.TRIANGLES)
@@ -647,18 +647,28 @@ def _chunk_fades(ctx: moderngl.Context) -> bool:
     return "float terminator_t" in ctx.includes.get("lighting", "")
 
 
-def _material_runs(gpu_meshes: list[GpuMesh],
-                   culled: frozenset[int] = frozenset()) -> list[list[GpuMesh]]:
-    """The meshes in order, cut where the material changes or where back-face culling
-    (``culled``: the id() of the meshes drawn culled) switches on or off."""
+def _material_runs(gpu_meshes: list[GpuMesh]) -> list[list[GpuMesh]]:
+    """The meshes in order, cut where the material changes."""
     runs: list[list[GpuMesh]] = []
     for gpu in gpu_meshes:
-        if (runs and runs[-1][0].mesh.material == gpu.mesh.material
-                and (id(runs[-1][0]) in culled) == (id(gpu) in culled)):
+        if runs and runs[-1][0].mesh.material == gpu.mesh.material:
             runs[-1].append(gpu)
         else:
             runs.append([gpu])
     return runs
+
+
+def _cull_runs(runs: list[list[GpuMesh]], culled: frozenset[int]) -> list[list[GpuMesh]]:
+    """The runs cut further where back-face culling (``culled``: the id() of the meshes
+    drawn culled) switches on or off."""
+    out: list[list[GpuMesh]] = []
+    for run in runs:
+        for gpu in run:
+            if gpu is not run[0] and (id(out[-1][0]) in culled) == (id(gpu) in culled):
+                out[-1].append(gpu)
+            else:
+                out.append([gpu])
+    return out
 
 
 def _closed_outward(vertices: np.ndarray, faces: np.ndarray) -> bool:
