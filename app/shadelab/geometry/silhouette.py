@@ -434,7 +434,8 @@ def count_volume(volume: ShadowVolume, light: np.ndarray, convex: bool) -> Count
     """The :class:`CountVolume` of a silhouette volume (:func:`shadow_volume` of a closed
     caster) for the homogeneous ``light``; ``convex``: the caster is convex (its near cap may
     become a fan). None where the caps must stay (no silhouette, or directions from the light
-    through the caster that do not fit in an open hemisphere: a light inside or among it)."""
+    through the caster that do not fit in an open hemisphere: a light inside or among it) or
+    where fans would not be smaller (as many silhouette edges as dark faces: a box)."""
     if volume.method != "silhouette" or len(volume.silhouette) == 0:
         return None
     v = volume.vertices
@@ -442,6 +443,8 @@ def count_volume(volume: ShadowVolume, light: np.ndarray, convex: bool) -> Count
     edges = volume.silhouette
     e = len(edges)
     d = (len(volume.faces) - 2 * e) // 2
+    if e >= d:
+        return None            # a fan per silhouette edge: no fewer faces than the cap (a box)
     sides = volume.faces[: 2 * e]
     near_cap = volume.faces[2 * e: 2 * e + d]
     directions = v[n:, :3]
