@@ -289,3 +289,89 @@ def test_fans_count_as_the_full_caps(gl_ctx, monkeypatch, eye, method):
     changed = casters & (fans != full)
     assert np.isin(fans[changed], (0, 1)).all()
     np.testing.assert_array_equal(image, image_full)
+
+
+# ------------------------------------------------------------------ hidden volumes
+def wall_vertices() -> np.ndarray:
+    x, y = np.meshgrid(np.linspace(-12.0, 12.0, 5), np.linspace(0.0, 8.0, 3))
+    return np.stack([x.ravel(), y.ravel(), np.full(x.size, -6.0)], axis=1)
+
+
+def wall_faces() -> np.ndarray:
+    faces = []
+    for row in range(2):
+        for col in range(4):
+            a = row * 5 + col
+            faces += [[a, a + 1, a + 6], [a, a + 6, a + 5]]
+    return np.array(faces)
+
+
+def _wall_occluder(eye_light=(3.0, 5.0, 3.0)):
+    from shadelab.geometry.silhouette import planar_occluder
+
+    vertices, faces = wall_vertices(), wall_faces()
+    normals = np.tile([0.0, 0.0, 1.0], (len(faces), 1))
+    floor = np.array([[-12.0, 0.0, -12.0], [12.0, 0.0, 12.0]])    # the lecture's floor
+    light = light_homogeneous("point", eye_light, (0, 0, 0))
+    return planar_occluder(vertices, faces, normals, light, [floor], 0.035, 1e-9)
+
+
+def test_a_wall_hides_its_volume_only_where_it_hides_what_lies_behind_it():
+    wall = _wall_occluder()
+    assert wall is not None
+    assert wall.hides_volume_from(np.array([0.0, 4.0, 7.5]), 0.1)      # the lecture's eye
+    assert wall.hides_volume_from(np.array([5.0, 1.0, 2.0]), 0.1)
+    assert not wall.hides_volume_from(np.array([0.0, 30.0, 7.5]), 0.1)  # sees over the top
+    assert not wall.hides_volume_from(np.array([20.0, 4.0, 0.0]), 0.1)  # round the side
+    assert not wall.hides_volume_from(np.array([0.0, 4.0, -8.0]), 0.1)  # behind it
+    assert not wall.hides_volume_from(np.array([0.0, 4.0, -5.95]), 0.1)  # near plane cuts it
+    # a floor reaching below the wall's foot shows under it
+    from shadelab.geometry.silhouette import planar_occluder
+
+    deeper = planar_occluder(wall_vertices(), wall_faces(), np.tile([0.0, 0.0, 1.0], (16, 1)),
+                             light_homogeneous("point", (3.0, 5.0, 3.0), (0, 0, 0)),
+                             [np.array([[-12.0, -0.5, -12.0], [12.0, 0.0, 12.0]])],
+                             0.035, 1e-9)
+    assert not deeper.hides_volume_from(np.array([0.0, 4.0, 7.5]), 0.1)
+    # a light behind the wall: its volume comes forward, towards the eye
+    lit_from_behind = _wall_occluder((0.0, 4.0, -9.0))
+    assert not lit_from_behind.hides_volume_from(np.array([0.0, 4.0, 7.5]), 0.1)
+
+
+def test_no_occluder_for_a_caster_that_is_not_flat_or_not_convex():
+    from shadelab.geometry.silhouette import planar_occluder
+
+    light = light_homogeneous("point", (3.0, 5.0, 3.0), (0, 0, 0))
+    fold = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0.5]], float)
+    faces = np.array([[0, 1, 2], [0, 2, 3]])
+    tri = fold[faces]
+    normals = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    assert planar_occluder(fold, faces, normals, light, [], 0.01, 1e-9) is None
+    # an L of three squares: flat, its outline not convex
+    ell = np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0], [1, 1, 0], [2, 1, 0],
+                    [0, 2, 0], [1, 2, 0]], float)
+    squares = [(0, 1, 4, 3), (1, 2, 5, 4), (3, 4, 7, 6)]
+    faces = np.array([f for a, b, c, d in squares for f in ((a, b, c), (a, c, d))])
+    normals = np.tile([0.0, 0.0, 1.0], (len(faces), 1))
+    assert planar_occluder(ell, faces, normals, light, [], 0.01, 1e-9) is None
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("eye", [None, "[0.0, 30.0, 7.5]", "[3.0, 1.5, -3.0]"])
+def test_leaving_out_hidden_volumes_keeps_the_counts(gl_ctx, monkeypatch, eye):
+    scene = load_preset("lecture", [f"camera.eye={eye}"] if eye else [])
+    monkeypatch.setattr(shadows_module, "HIDDEN_VOLUMES_LEFT_OUT", False)
+    image_all, every = _frame(gl_ctx, scene)
+    monkeypatch.setattr(shadows_module, "HIDDEN_VOLUMES_LEFT_OUT", True)
+    renderer = Renderer(gl_ctx)
+    try:
+        view = renderer.render(scene, RenderTarget(gl_ctx, SIZE))
+        wall = [v for v in renderer.shadow_volumes._cache.values() if v.occluder is not None]
+        assert len(wall) == 1
+        assert wall[0].hidden_from(view) == (eye != "[0.0, 30.0, 7.5]")
+        image, left_out = _frame(gl_ctx, scene, renderer)
+    finally:
+        renderer.release()
+    np.testing.assert_array_equal(left_out, every)
+    np.testing.assert_array_equal(image, image_all)

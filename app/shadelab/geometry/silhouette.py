@@ -473,3 +473,141 @@ def is_convex(vertices: np.ndarray, faces: np.ndarray) -> bool:
     if mesh is None:
         return False
     return bool(trimesh.Trimesh(mesh.vertices, mesh.faces, process=False).is_convex)
+
+
+@dataclass
+class PlanarOccluder:
+    """A flat, opaque caster whose volume only holds what lies behind it (see
+    :func:`planar_occluder`): the receivers' parts that its volume can reach, as points, and
+    what it takes to see that they are hidden behind the caster itself from an eye."""
+
+    normal: np.ndarray     # (3,) unit normal of the caster's plane, towards the light's side
+    d: float               # plane: normal . x = d
+    origin: np.ndarray     # (3,) a point of the plane; axes (2, 3): the plane's 2-D frame
+    axes: np.ndarray
+    hull: np.ndarray       # (H, 2, 2) the outline's edges in the frame, counter-clockwise
+    points: np.ndarray     # (P, 3) corners of the receivers' boxes clipped behind the caster
+
+    def hides_volume_from(self, eye: np.ndarray, near_reach: float) -> bool:
+        """Is every point the volume can hold hidden from ``eye`` behind the caster itself?
+        The eye must be on the light's side, farther from the plane than the near plane
+        reaches (which could cut the caster away), and every clipped corner must project
+        through the caster's outline onto the eye (with a margin of 1e-9 of the outline)."""
+        height = float(eye @ self.normal - self.d)
+        if not height > 1.01 * near_reach + 1e-9:
+            return False
+        if len(self.points) == 0:
+            return True
+        depth = self.d - self.points @ self.normal          # > 0: behind the plane
+        t = height / (height + depth)
+        crossing = eye + t[:, None] * (self.points - eye)   # on the plane, between them
+        uv = (crossing - self.origin) @ self.axes.T
+        a, b = self.hull[:, 0], self.hull[:, 1]
+        edge = b - a
+        cross = edge[None, :, 0] * (uv[:, None, 1] - a[None, :, 1]) \
+            - edge[None, :, 1] * (uv[:, None, 0] - a[None, :, 0])
+        scale = max(float(np.abs(self.hull).max()), 1e-300)
+        return bool((cross > 1e-9 * scale * np.linalg.norm(edge, axis=1)[None, :]).all())
+
+
+def planar_occluder(vertices: np.ndarray, faces: np.ndarray, face_normals: np.ndarray,
+                    light: np.ndarray, boxes: list[np.ndarray], offset: float,
+                    tolerance: float) -> PlanarOccluder | None:
+    """The :class:`PlanarOccluder` of an opaque open caster for one homogeneous ``light``, or
+    None where it is not one: the caster must be flat (one plane within ``tolerance``, every
+    face normal parallel), with a convex outline (its triangles' areas add up to their convex
+    hull's), and the light off its plane.
+
+    Its per-triangle volumes (:func:`open_volume`) lie behind the plane as seen from the light,
+    their caps moved ``offset`` along the rays (at least ``offset`` min(1, GRAZING_LIMIT |N.d|)
+    off the plane). So the receivers' surfaces inside the volume lie inside their boxes
+    ``boxes`` ((2, 3) min / max) clipped to the half-space half that distance behind the plane:
+    the corners of those clipped boxes are kept. An eye on the light's side that sees each of
+    them through the caster sees none of them (the caster is opaque and in front), so no
+    visible point is inside the volume and its count is 0 on every pixel: the back wall of the
+    lecture's scene, seen from the front.
+    """
+    vertices = np.asarray(vertices, dtype=np.float64)
+    faces = np.asarray(faces, dtype=np.int64)
+    if len(faces) == 0 or len(face_normals) == 0:
+        return None
+    normal = np.asarray(face_normals[0], dtype=np.float64)
+    normal = normal / max(np.linalg.norm(normal), 1e-300)
+    if np.abs(face_normals @ normal).min() < 1.0 - 1e-9:
+        return None
+    d = float(vertices[faces[0, 0]] @ normal)
+    if np.abs(vertices @ normal - d).max() > tolerance:
+        return None
+    side = float(light[:3] @ normal - light[3] * d)
+    if abs(side) <= 1e-12:
+        return None
+    if side < 0.0:
+        normal, d = -normal, -d
+    # the plane's frame and the outline
+    helper = np.eye(3)[int(np.argmin(np.abs(normal)))]
+    u = np.cross(normal, helper)
+    u /= np.linalg.norm(u)
+    v = np.cross(normal, u)
+    axes = np.stack([u, v])
+    origin = d * normal
+    used = np.unique(faces)
+    flat = (vertices[used] - origin) @ axes.T
+    hull = _convex_hull_2d(flat)
+    if len(hull) < 3:
+        return None
+    tri = (vertices[faces] - origin) @ axes.T
+    ab, ac = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+    areas = 0.5 * np.abs(ab[:, 0] * ac[:, 1] - ab[:, 1] * ac[:, 0]).sum()
+    hull_area = 0.5 * abs(float(np.sum(hull[:, 0] * np.roll(hull[:, 1], -1)
+                                       - np.roll(hull[:, 0], -1) * hull[:, 1])))
+    if not abs(areas - hull_area) <= 1e-9 * max(hull_area, 1e-300):
+        return None
+    # how far behind the plane the volume starts, at the least
+    away = away_from_light(vertices[used], light)
+    cosine = float(np.abs(away @ normal).min())
+    behind = 0.5 * offset * min(1.0, GRAZING_LIMIT * cosine) - tolerance
+    if not behind > 0.0:
+        return None
+    points = [_box_behind(box, normal, d - behind) for box in boxes]
+    points = np.concatenate(points) if points else np.zeros((0, 3))
+    edges = np.stack([hull, np.roll(hull, -1, axis=0)], axis=1)
+    return PlanarOccluder(normal, d, origin, axes, edges, points)
+
+
+def _box_behind(box: np.ndarray, normal: np.ndarray, level: float) -> np.ndarray:
+    """Corners of the (2, 3) box clipped to ``normal . x <= level``: the box's corners there
+    and where its edges cross the plane (the clipped box is their convex hull)."""
+    corners = np.asarray(box, dtype=np.float64)[_CORNER_PICK, [0, 1, 2]]      # (8, 3)
+    height = corners @ normal - level
+    keep = [corners[height <= 0.0]]
+    for i in range(8):
+        for j in range(i + 1, 8):
+            if bin(i ^ j).count("1") != 1:
+                continue                                   # not an edge of the box
+            hi, hj = height[i], height[j]
+            if (hi < 0.0 < hj) or (hj < 0.0 < hi):
+                t = hi / (hi - hj)
+                keep.append((corners[i] + t * (corners[j] - corners[i]))[None])
+    return np.concatenate(keep)
+
+
+def _convex_hull_2d(points: np.ndarray) -> np.ndarray:
+    """(H, 2) convex hull, counter-clockwise, no collinear points (Andrew's monotone chain)."""
+    pts = np.unique(np.round(points, 12), axis=0)
+    if len(pts) < 3:
+        return pts
+
+    def turn(o, a, b) -> float:
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+    lower: list = []
+    for p in pts:
+        while len(lower) >= 2 and turn(lower[-2], lower[-1], p) <= 0.0:
+            lower.pop()
+        lower.append(p)
+    upper: list = []
+    for p in pts[::-1]:
+        while len(upper) >= 2 and turn(upper[-2], upper[-1], p) <= 0.0:
+            upper.pop()
+        upper.append(p)
+    return np.array(lower[:-1] + upper[:-1])

@@ -27,12 +27,14 @@ import numpy as np
 from shadelab.geometry.mesh import scene_bounds
 from shadelab.geometry.silhouette import (
     CountVolume,
+    PlanarOccluder,
     ShadowVolume,
     closed_caster,
     count_volume,
     is_convex,
     open_caster_groups,
     open_volume,
+    planar_occluder,
     shadow_volume,
     shadows_nothing,
 )
@@ -55,6 +57,10 @@ FILTER_SLOTS = 4  # transparent casters filtered per light; further ones cast no
 # The stencil count draws closed casters' volumes with fans for caps where the counts are the
 # same (silhouette.CountVolume); False counts with the full caps (A/B measurements, tests)
 REDUCED_CAPS = True
+# The count leaves out a flat opaque caster's volume where everything that volume could hold
+# is hidden behind that caster from the eye (silhouette.PlanarOccluder: the lecture's back
+# wall); False counts every volume (A/B measurements, tests)
+HIDDEN_VOLUMES_LEFT_OUT = True
 
 
 def filter_bit(slot: int) -> int:
@@ -94,6 +100,14 @@ class CasterVolume:
     count_vbo: moderngl.Buffer | None = None
     count_vao: moderngl.VertexArray | None = None
     bounds: np.ndarray | None = None  # the caster's (2, 3) world box (closed casters)
+    occluder: PlanarOccluder | None = None  # a flat opaque caster's (set per frame)
+
+    def hidden_from(self, view) -> bool:
+        """Is nothing the volume could hold visible from the view's eye (its count 0 on
+        every pixel)? Only for a flat opaque caster (:class:`PlanarOccluder`)."""
+        return (HIDDEN_VOLUMES_LEFT_OUT and self.occluder is not None
+                and self.occluder.hides_volume_from(view.eye, getattr(view, "near_reach",
+                                                                      np.inf)))
 
     def release(self) -> None:
         for item in (self.vao, self.vbo, self.line_vao, self.line_vbo, self.count_vao,
@@ -132,6 +146,7 @@ class ShadowVolumes:
         self._convex: dict[tuple, bool] = {}  # geometry key -> convex closed caster?
         self._grouping: dict[tuple, list[list[int]]] = {}  # recent groupings of open casters
         self._skips: dict[tuple, list[bool]] = {}  # recent shadows_nothing answers
+        self._occluders: dict[tuple, PlanarOccluder | None] = {}  # recent planar_occluder
         self._offset_key: tuple | None = None   # the meshes _offset_value was measured on
         self._offset_value = 0.0
         quad = np.array([[-1, -1, 1, 1], [1, -1, 1, 1], [1, 1, 1, 1],
@@ -177,9 +192,11 @@ class ShadowVolumes:
             slot = (("open",) + tuple(g.mesh.index for g in members), light_index)
             key = (tuple(g.key for g in members), light_key(light), offset)
             live.add(slot)
-            out.append(self._cached(slot, key, members[0].mesh.index, lambda m=members: (
+            caster = self._cached(slot, key, members[0].mesh.index, lambda m=members: (
                 open_volume([(g.mesh.vertices, g.mesh.faces) for g in m], homogeneous,
-                            offset))))
+                            offset)))
+            caster.occluder = self._occluder(members, gpu_meshes, light, homogeneous, offset)
+            out.append(caster)
         for slot in [s for s in self._cache if s[1] == light_index and s not in live]:
             self._cache.pop(slot).release()
         return out
@@ -193,6 +210,27 @@ class ShadowVolumes:
                 scene_bounds([g.mesh for g in gpu_meshes]), axis=0)))
             self._offset_key = key
         return self._offset_value
+
+    def _occluder(self, members, gpu_meshes, light: Light, homogeneous: np.ndarray,
+                  offset: float) -> PlanarOccluder | None:
+        """:func:`planar_occluder` of a group of opaque open casters (one flat caster),
+        the other meshes' boxes as receivers; memoized on every mesh's geometry."""
+        key = (tuple(g.key for g in members), tuple(g.key for g in gpu_meshes),
+               light_key(light), offset)
+        if key not in self._occluders:
+            vertices, faces, normals, base = [], [], [], 0
+            for g in members:
+                vertices.append(g.mesh.vertices)
+                faces.append(np.asarray(g.mesh.faces) + base)
+                normals.append(g.mesh.face_normals)
+                base += len(g.mesh.vertices)
+            receivers = [g.bounds for g in gpu_meshes if not any(g is m for m in members)]
+            if len(self._occluders) > 64:
+                self._occluders.clear()
+            self._occluders[key] = planar_occluder(
+                np.concatenate(vertices), np.concatenate(faces), np.concatenate(normals),
+                homogeneous, receivers, offset, 1e-6 * offset)
+        return self._occluders[key]
 
     def _skipped(self, gpu_meshes, light: Light, homogeneous: np.ndarray,
                  offset: float) -> list[bool]:
@@ -275,6 +313,7 @@ class ShadowVolumes:
             caster.release()
         self._cache.clear()
         self._skips.clear()
+        self._occluders.clear()
         self._grouping.clear()
         self._offset_key = None
         self._closed.clear()
@@ -320,7 +359,8 @@ class ShadowVolumes:
         set_uniform(self.program, "u_clip_from_world", gl_matrix(view.clip_from_world))
         set_uniform(self.program, "u_color", (0.0, 0.0, 0.0, 0.0))
         for caster in volumes:
-            caster.render_count(view)
+            if not caster.hidden_from(view):
+                caster.render_count(view)
         GL.glDisable(GL.GL_DEPTH_CLAMP)
         GL.glStencilOp(GL.GL_KEEP, GL.GL_KEEP, GL.GL_KEEP)
         target.fbo.color_mask = (True, True, True, True)
