@@ -381,3 +381,233 @@ def shadows_nothing(vertices: np.ndarray, face_normals: np.ndarray, light: np.nd
 
 
 _CORNER_PICK = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)])
+
+
+@dataclass
+class CountVolume:
+    """A silhouette volume with cheaper caps, for the stencil count only (the same counts as
+    the full volume wherever :meth:`ranges` says so; shown volumes keep their full caps).
+
+    The count at a point is the winding number of the volume's closed surface around it, a
+    sum over its faces that depends on a cap only through the cap's boundary (the silhouette
+    loops) and through the points that lie between the cap and its replacement:
+
+    * the far cap (the dark faces at infinity, w = 0) lies at depth 1 in every pixel (z = w
+      exactly with the infinite far plane): it is counted wherever it covers the pixel, and
+      only its coverage of the screen matters. A fan from one point at infinity over the
+      extruded silhouette edges has the same boundary; with every direction from the light
+      through the caster in one open hemisphere around the apex (the light outside the
+      caster's reach, :func:`count_volume` checks), fan and cap are the same chain on the
+      plane at infinity, and cover every pixel the same number of times;
+    * the near cap (the dark faces, turned) can become a fan from a point inside the caster
+      over the silhouette loops when the caster is convex: the fan lies inside the caster,
+      behind its lit faces from the light, and the counts change only between the fan and
+      the dark faces, inside the caster, where no visible surface lies while the eye is
+      outside the caster (the dark faces themselves count 1 either way: in shadow).
+
+    ``faces`` are [sides, far fan, near fan, near cap (the dark faces, turned)], into
+    ``vertices`` (the volume's, then the near apex (w = 1) and the far apex (w = 0)).
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    sides_and_far: int   # faces: the sides and the far fan
+    near_fan: int        # faces: the near fan (0 when the caster is not convex)
+    near_cap: int        # faces: the dark faces, turned
+
+    def ranges(self, eye_outside: bool) -> list[tuple[int, int]]:
+        """(first face, face count) to draw: the near fan only with the eye outside the
+        caster (its bounding box grown by the near plane's reach), else the near cap."""
+        if eye_outside and self.near_fan:
+            return [(0, self.sides_and_far + self.near_fan)]
+        if self.near_fan:
+            return [(0, self.sides_and_far),
+                    (self.sides_and_far + self.near_fan, self.near_cap)]
+        return [(0, self.sides_and_far + self.near_cap)]
+
+    def triangles(self) -> np.ndarray:
+        """(K, 3, 4) float32 triangle soup for the GPU."""
+        return self.vertices[self.faces].astype(np.float32)
+
+
+def count_volume(volume: ShadowVolume, light: np.ndarray, convex: bool) -> CountVolume | None:
+    """The :class:`CountVolume` of a silhouette volume (:func:`shadow_volume` of a closed
+    caster) for the homogeneous ``light``; ``convex``: the caster is convex (its near cap may
+    become a fan). None where the caps must stay (no silhouette, or directions from the light
+    through the caster that do not fit in an open hemisphere: a light inside or among it) or
+    where fans would not be smaller (as many silhouette edges as dark faces: a box)."""
+    if volume.method != "silhouette" or len(volume.silhouette) == 0:
+        return None
+    v = volume.vertices
+    n = len(v) // 2
+    edges = volume.silhouette
+    e = len(edges)
+    d = (len(volume.faces) - 2 * e) // 2
+    if e >= d:
+        return None            # a fan per silhouette edge: no fewer faces than the cap (a box)
+    sides = volume.faces[: 2 * e]
+    near_cap = volume.faces[2 * e: 2 * e + d]
+    directions = v[n:, :3]
+    mean = directions.sum(axis=0)
+    length = np.linalg.norm(mean)
+    if not length > 0.0:
+        return None
+    mean = mean / length
+    if light[3] != 0.0 and float((directions @ mean).min()) <= 1e-6:
+        return None            # not within an open hemisphere: keep the far cap
+    near_apex = v[np.unique(edges), :3].mean(axis=0)
+    vertices = np.concatenate([v, [[*near_apex, 1.0], [*mean, 0.0]]])
+    a, b = edges[:, 0], edges[:, 1]
+    far_fan = np.stack([np.full(e, 2 * n + 1), b + n, a + n], axis=1)
+    near_fan = np.stack([np.full(e, 2 * n), a, b], axis=1) if convex \
+        else np.zeros((0, 3), np.int64)
+    faces = np.concatenate([sides, far_fan, near_fan, near_cap]).astype(np.int64)
+    return CountVolume(vertices, faces, len(sides) + e, len(near_fan), len(near_cap))
+
+
+def is_convex(vertices: np.ndarray, faces: np.ndarray) -> bool:
+    """Is the closed caster (:func:`closed_caster`) convex (trimesh's test)?"""
+    import trimesh
+
+    mesh = closed_caster(vertices, faces)
+    if mesh is None:
+        return False
+    return bool(trimesh.Trimesh(mesh.vertices, mesh.faces, process=False).is_convex)
+
+
+@dataclass
+class PlanarOccluder:
+    """A flat, opaque caster whose volume only holds what lies behind it (see
+    :func:`planar_occluder`): the receivers' parts that its volume can reach, as points, and
+    what it takes to see that they are hidden behind the caster itself from an eye."""
+
+    normal: np.ndarray     # (3,) unit normal of the caster's plane, towards the light's side
+    d: float               # plane: normal . x = d
+    origin: np.ndarray     # (3,) a point of the plane; axes (2, 3): the plane's 2-D frame
+    axes: np.ndarray
+    hull: np.ndarray       # (H, 2, 2) the outline's edges in the frame, counter-clockwise
+    points: np.ndarray     # (P, 3) corners of the receivers' boxes clipped behind the caster
+
+    def hides_volume_from(self, eye: np.ndarray, near_reach: float) -> bool:
+        """Is every point the volume can hold hidden from ``eye`` behind the caster itself?
+        The eye must be on the light's side, farther from the plane than the near plane
+        reaches (which could cut the caster away), and every clipped corner must project
+        through the caster's outline onto the eye (with a margin of 1e-9 of the outline)."""
+        height = float(eye @ self.normal - self.d)
+        if not height > 1.01 * near_reach + 1e-9:
+            return False
+        if len(self.points) == 0:
+            return True
+        depth = self.d - self.points @ self.normal          # > 0: behind the plane
+        t = height / (height + depth)
+        crossing = eye + t[:, None] * (self.points - eye)   # on the plane, between them
+        uv = (crossing - self.origin) @ self.axes.T
+        a, b = self.hull[:, 0], self.hull[:, 1]
+        edge = b - a
+        cross = edge[None, :, 0] * (uv[:, None, 1] - a[None, :, 1]) \
+            - edge[None, :, 1] * (uv[:, None, 0] - a[None, :, 0])
+        scale = max(float(np.abs(self.hull).max()), 1e-300)
+        return bool((cross > 1e-9 * scale * np.linalg.norm(edge, axis=1)[None, :]).all())
+
+
+def planar_occluder(vertices: np.ndarray, faces: np.ndarray, face_normals: np.ndarray,
+                    light: np.ndarray, boxes: list[np.ndarray], offset: float,
+                    tolerance: float) -> PlanarOccluder | None:
+    """The :class:`PlanarOccluder` of an opaque open caster for one homogeneous ``light``, or
+    None where it is not one: the caster must be flat (one plane within ``tolerance``, every
+    face normal parallel), with a convex outline (its triangles' areas add up to their convex
+    hull's), and the light off its plane.
+
+    Its per-triangle volumes (:func:`open_volume`) lie behind the plane as seen from the light,
+    their caps moved ``offset`` along the rays (at least ``offset`` min(1, GRAZING_LIMIT |N.d|)
+    off the plane). So the receivers' surfaces inside the volume lie inside their boxes
+    ``boxes`` ((2, 3) min / max) clipped to the half-space half that distance behind the plane:
+    the corners of those clipped boxes are kept. An eye on the light's side that sees each of
+    them through the caster sees none of them (the caster is opaque and in front), so no
+    visible point is inside the volume and its count is 0 on every pixel: the back wall of the
+    lecture's scene, seen from the front.
+    """
+    vertices = np.asarray(vertices, dtype=np.float64)
+    faces = np.asarray(faces, dtype=np.int64)
+    if len(faces) == 0 or len(face_normals) == 0:
+        return None
+    normal = np.asarray(face_normals[0], dtype=np.float64)
+    normal = normal / max(np.linalg.norm(normal), 1e-300)
+    if np.abs(face_normals @ normal).min() < 1.0 - 1e-9:
+        return None
+    d = float(vertices[faces[0, 0]] @ normal)
+    if np.abs(vertices @ normal - d).max() > tolerance:
+        return None
+    side = float(light[:3] @ normal - light[3] * d)
+    if abs(side) <= 1e-12:
+        return None
+    if side < 0.0:
+        normal, d = -normal, -d
+    # the plane's frame and the outline
+    helper = np.eye(3)[int(np.argmin(np.abs(normal)))]
+    u = np.cross(normal, helper)
+    u /= np.linalg.norm(u)
+    v = np.cross(normal, u)
+    axes = np.stack([u, v])
+    origin = d * normal
+    used = np.unique(faces)
+    flat = (vertices[used] - origin) @ axes.T
+    hull = _convex_hull_2d(flat)
+    if len(hull) < 3:
+        return None
+    tri = (vertices[faces] - origin) @ axes.T
+    ab, ac = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+    areas = 0.5 * np.abs(ab[:, 0] * ac[:, 1] - ab[:, 1] * ac[:, 0]).sum()
+    hull_area = 0.5 * abs(float(np.sum(hull[:, 0] * np.roll(hull[:, 1], -1)
+                                       - np.roll(hull[:, 0], -1) * hull[:, 1])))
+    if not abs(areas - hull_area) <= 1e-9 * max(hull_area, 1e-300):
+        return None
+    # how far behind the plane the volume starts, at the least
+    away = away_from_light(vertices[used], light)
+    cosine = float(np.abs(away @ normal).min())
+    behind = 0.5 * offset * min(1.0, GRAZING_LIMIT * cosine) - tolerance
+    if not behind > 0.0:
+        return None
+    points = [_box_behind(box, normal, d - behind) for box in boxes]
+    points = np.concatenate(points) if points else np.zeros((0, 3))
+    edges = np.stack([hull, np.roll(hull, -1, axis=0)], axis=1)
+    return PlanarOccluder(normal, d, origin, axes, edges, points)
+
+
+def _box_behind(box: np.ndarray, normal: np.ndarray, level: float) -> np.ndarray:
+    """Corners of the (2, 3) box clipped to ``normal . x <= level``: the box's corners there
+    and where its edges cross the plane (the clipped box is their convex hull)."""
+    corners = np.asarray(box, dtype=np.float64)[_CORNER_PICK, [0, 1, 2]]      # (8, 3)
+    height = corners @ normal - level
+    keep = [corners[height <= 0.0]]
+    for i in range(8):
+        for j in range(i + 1, 8):
+            if bin(i ^ j).count("1") != 1:
+                continue                                   # not an edge of the box
+            hi, hj = height[i], height[j]
+            if (hi < 0.0 < hj) or (hj < 0.0 < hi):
+                t = hi / (hi - hj)
+                keep.append((corners[i] + t * (corners[j] - corners[i]))[None])
+    return np.concatenate(keep)
+
+
+def _convex_hull_2d(points: np.ndarray) -> np.ndarray:
+    """(H, 2) convex hull, counter-clockwise, no collinear points (Andrew's monotone chain)."""
+    pts = np.unique(np.round(points, 12), axis=0)
+    if len(pts) < 3:
+        return pts
+
+    def turn(o, a, b) -> float:
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+    lower: list = []
+    for p in pts:
+        while len(lower) >= 2 and turn(lower[-2], lower[-1], p) <= 0.0:
+            lower.pop()
+        lower.append(p)
+    upper: list = []
+    for p in pts[::-1]:
+        while len(upper) >= 2 and turn(upper[-2], upper[-1], p) <= 0.0:
+            upper.pop()
+        upper.append(p)
+    return np.array(lower[:-1] + upper[:-1])

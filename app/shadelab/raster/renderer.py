@@ -27,7 +27,7 @@ from shadelab.gl.vertex import soup_vertex_array, triangle_soup
 from shadelab.raster.painter import draw_painter
 from shadelab.raster.textures import TextureCache, has_surface_detail
 from shadelab.raster.transparency import draw_transparent
-from shadelab.scene.camera import clip_from_world, far_plane, gl_matrix
+from shadelab.scene.camera import clip_from_world, far_plane, gl_matrix, tan_half_fov_y
 from shadelab.scene.model import MAX_LIGHTS, Light, Material, Scene
 from shadelab.shading.codes import ATTENUATION_CODES, CODE_BITS, SPECULAR_CODES, TERM_BITS
 from shadelab.shading.lights import light_kind
@@ -47,6 +47,9 @@ TEXTURED_PROGRAMS = {name: f"{name}_tex" for name in SHADING_PROGRAMS}
 # The programs whose Od is the material's u_Od: compiled with PREMULTIPLIED (lighting.glsl), so
 # the per-material, per-light factors are folded here once instead of read per fragment.
 PREMULTIPLIED = {"PREMULTIPLIED": 1}
+# Opaque closed meshes seen from outside are drawn with their back faces culled
+# (Renderer.cullable); False draws every face (for A/B measurements and tests)
+BACK_FACE_CULLING = True
 
 
 class ProgramVariant(dict):
@@ -97,6 +100,9 @@ class View:
     clip_from_world: np.ndarray
     eye: np.ndarray
     size: tuple[int, int]
+    # how far from the eye the near plane reaches (:func:`near_reach`); inf: unknown, and
+    # nothing is taken to be seen from outside
+    near_reach: float = math.inf
 
 
 class ProgramUniforms:
@@ -127,7 +133,8 @@ def make_view(scene: Scene, size: tuple[int, int], meshes: list[MeshData],
         bounds = scene_bounds(meshes)
     far = math.inf if infinite_far else far_plane(scene.camera, bounds)
     eye = np.asarray(scene.camera.eye, dtype=np.float64)
-    return View(clip_from_world(scene.camera, aspect, far), eye, size)
+    return View(clip_from_world(scene.camera, aspect, far), eye, size,
+                near_reach(scene, size))
 
 
 class Renderer:
@@ -154,6 +161,8 @@ class Renderer:
         self._gpu: dict[int, GpuMesh] = {}
         self._shadows = None  # shadelab.raster.shadows.ShadowVolumes, made on first use
         self.terms_off = 0    # the frame's u_terms_off bits (render's ``terms_off``)
+        self._outward: dict[tuple, bool] = {}  # geometry key -> closed, wound outward (culling)
+        self._culled: frozenset[int] = frozenset()  # id() of the frame's back-face-culled meshes
 
     @staticmethod
     def light_signature_of(lights: list[Light], specular: str) -> tuple:
@@ -380,6 +389,8 @@ class Renderer:
         view = self.view_for(scene, target.size, gpu_meshes, volumes_on)
         opaque = [g for g in gpu_meshes if not is_transparent(scene.materials[g.mesh.material])]
         clear = [g for g in gpu_meshes if is_transparent(scene.materials[g.mesh.material])]
+        self._culled = frozenset(id(g) for g in opaque if BACK_FACE_CULLING
+                                 and self.cullable(g, scene, target.size))
         # --- PASS 1: clear color, depth and stencil
         target.clear(settings.background)
         if painter:
@@ -538,20 +549,56 @@ class Renderer:
                      terminator: bool = False) -> None:
         """Draw each mesh with its material; ``terminator`` (the shadow-volume lit pass) turns
         on the fade of S_i where N.L nears each point's terminator threshold (u_terminator 1)
-        on smooth meshes, unless the renderer is ``exact``."""
+        on smooth meshes, unless the renderer is ``exact``.
+
+        The frame's culled meshes (:meth:`cullable`: closed, wound outward, seen from outside)
+        are drawn with back faces culled: every pixel a back face covers is covered nearer by
+        a front face of the same mesh, so the image is the same with less fill and shading."""
         # flat: N = Ng, nothing to join
         soften = terminator and shading != "flat" and not self.exact
-        if not terminator:  # no per-mesh uniform: one draw per run of one material
-            for run in _material_runs(gpu_meshes):
-                program_name = self.use_material(scene, run[0].mesh.material, shading)
-                self.vao(self._batch(run), program_name).render(moderngl.TRIANGLES)
-            return
-        for gpu in gpu_meshes:
-            program_name = self.use_material(scene, gpu.mesh.material, shading)
-            if terminator:
-                set_uniform(self.programs[program_name], "u_terminator",
-                            1.0 if soften and gpu.mesh.corner_terminators.any() else 0.0)
-            self.vao(gpu, program_name).render(moderngl.TRIANGLES)
+        culled = self._culled
+        culling = False
+        try:
+            if not terminator:  # no per-mesh uniform: one draw per run of one material
+                for run in _cull_runs(_material_runs(gpu_meshes), culled):
+                    culling = self._cull(id(run[0]) in culled, culling)
+                    program_name = self.use_material(scene, run[0].mesh.material, shading)
+                    self.vao(self._batch(run), program_name).render(moderngl.TRIANGLES)
+                return
+            for gpu in gpu_meshes:
+                culling = self._cull(id(gpu) in culled, culling)
+                program_name = self.use_material(scene, gpu.mesh.material, shading)
+                if terminator:
+                    set_uniform(self.programs[program_name], "u_terminator",
+                                1.0 if soften and gpu.mesh.corner_terminators.any() else 0.0)
+                self.vao(gpu, program_name).render(moderngl.TRIANGLES)
+        finally:
+            self._cull(False, culling)
+
+    def _cull(self, on: bool, now: bool) -> bool:
+        """Switch back-face culling to ``on`` if it is not so ``now``; returns ``on``."""
+        if on != now:
+            if on:
+                self.ctx.front_face = "ccw"
+                self.ctx.cull_face = "back"
+                self.ctx.enable(moderngl.CULL_FACE)
+            else:
+                self.ctx.disable(moderngl.CULL_FACE)
+        return on
+
+    def cullable(self, gpu: GpuMesh, scene: Scene, size: tuple[int, int]) -> bool:
+        """Can the opaque mesh be drawn with its back faces culled, image unchanged? Only a
+        closed, consistently wound mesh wound counter-clockwise seen from outside (memoized
+        per geometry), with the eye outside its bounding box grown by the reach of the near
+        plane (else the near plane could cut a front face away and show the inside: the
+        Cornell room, a camera inside a sphere)."""
+        outward = self._outward.get(gpu.key)
+        if outward is None:
+            outward = _closed_outward(gpu.mesh.vertices, gpu.mesh.faces)
+            if len(self._outward) > 256:
+                self._outward.clear()
+            self._outward[gpu.key] = outward
+        return outward and eye_outside(gpu.bounds, scene, size)
 
     def _batch(self, run: list[GpuMesh]) -> GpuMesh:
         """Consecutive meshes of one material as one buffer (copied on the GPU once, kept
@@ -609,6 +656,47 @@ def _material_runs(gpu_meshes: list[GpuMesh]) -> list[list[GpuMesh]]:
         else:
             runs.append([gpu])
     return runs
+
+
+def _cull_runs(runs: list[list[GpuMesh]], culled: frozenset[int]) -> list[list[GpuMesh]]:
+    """The runs cut further where back-face culling (``culled``: the id() of the meshes
+    drawn culled) switches on or off."""
+    out: list[list[GpuMesh]] = []
+    for run in runs:
+        for gpu in run:
+            if gpu is not run[0] and (id(out[-1][0]) in culled) == (id(gpu) in culled):
+                out[-1].append(gpu)
+            else:
+                out.append([gpu])
+    return out
+
+
+def _closed_outward(vertices: np.ndarray, faces: np.ndarray) -> bool:
+    """Is the mesh closed and consistently wound (:func:`closed_caster`) with its faces, as
+    drawn, counter-clockwise seen from outside (a positive signed volume)?"""
+    from shadelab.geometry.silhouette import closed_caster
+
+    if len(faces) == 0 or closed_caster(vertices, faces) is None:
+        return False
+    tri = np.asarray(vertices, dtype=np.float64)[np.asarray(faces, dtype=np.int64)]
+    tri = tri - tri.reshape(-1, 3).mean(axis=0)
+    volume = np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum() / 6.0
+    return bool(volume > 0.0)
+
+
+def near_reach(scene: Scene, size: tuple[int, int]) -> float:
+    """The farthest the near plane's rectangle reaches from the eye: anything the near plane
+    cuts away of what the image shows lies within this distance of the eye."""
+    aspect = size[0] / size[1]
+    tan_half = tan_half_fov_y(scene.camera, aspect)
+    return scene.camera.near * math.sqrt(1.0 + tan_half * tan_half * (1.0 + aspect * aspect))
+
+
+def eye_outside(bounds: np.ndarray, scene: Scene, size: tuple[int, int]) -> bool:
+    """Is the eye farther than :func:`near_reach` (and a margin) from the (2, 3) box?"""
+    eye = np.asarray(scene.camera.eye, dtype=np.float64)
+    gap = np.maximum(np.maximum(bounds[0] - eye, eye - bounds[1]), 0.0)
+    return bool(np.linalg.norm(gap) > 1.01 * near_reach(scene, size) + 1e-9)
 
 
 def _union_bounds(boxes: list[np.ndarray]) -> np.ndarray | None:
