@@ -171,7 +171,7 @@ def test_first_lit_image_comes_before_the_form_factor_matrix():
     the same B to rounding)."""
     scene = _cornell()
     pipeline._RADIOSITY_CACHE.clear()
-    seen = list(pipeline.pipeline_radiosity(scene, None, step_shots=1))
+    seen = list(pipeline.pipeline_radiosity(scene, None))
     assert seen[0].message == "meshing"
     preview = seen[1]
     assert preview.stats["preview"] is True and preview.stats["shots"] == 1
@@ -182,6 +182,10 @@ def test_first_lit_image_comes_before_the_form_factor_matrix():
     assert "preview" not in solved.stats
     assert solved.stats["shooter_index"] == preview.stats["shooter_index"]
     np.testing.assert_allclose(preview.stats["B"], solved.stats["B"], rtol=1e-12, atol=1e-12)
-    # a second job on the same geometry knows F already: no preview
-    again = list(pipeline.pipeline_radiosity(scene, None, step_shots=1))
+    # a second job on the same geometry knows F already: no preview; nor in step mode
+    # (each press of Step shoots one shot of the solve itself)
+    again = list(pipeline.pipeline_radiosity(scene, None))
     assert not any(p.stats.get("preview") for p in again)
+    pipeline._RADIOSITY_CACHE.clear()
+    stepped = list(pipeline.pipeline_radiosity(scene, None, step_shots=1))
+    assert not any(p.stats.get("preview") for p in stepped)

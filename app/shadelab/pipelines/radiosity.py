@@ -284,7 +284,8 @@ def _shoot(scene, patches, ff, method, rows, token, reused, note, start, step_sh
         shot[i] = latest[0][i] if latest[0] is not None else math.pi * emission[i]
         return rows[i]
 
-    if settings.solver == "progressive" and not rows:   # no form factor known yet
+    # no form factor known yet; not shot by shot (step mode: each press shoots one real shot)
+    if settings.solver == "progressive" and not rows and step_shots <= 0:
         yield _first_shot(scene, patches, ff, method, rho, emission, base, start, plan,
                           rows, fresh)
     # the same driver as run(): right-hand side with the lights' first shot, form factors,
