@@ -63,7 +63,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--help-overlay", action="store_true", help="show the shortcut help")
     p.add_argument("--no-autosave", action="store_true", help="do not write the session")
     p.add_argument("--bench-json", help=argparse.SUPPRESS)
-    p.add_argument("--bench-page-down", action="store_true", help=argparse.SUPPRESS)
+    p.add_argument("--bench-page-down", nargs="?", type=int, const=1, default=0,
+                   help=argparse.SUPPRESS)
     p.add_argument("--no-prefetch", action="store_true",
                    help="with --lesson: do not render the next step's offline pipeline "
                         "ahead of time")
@@ -217,6 +218,8 @@ def run_view(args: argparse.Namespace) -> int:
         check_focus(args.focus)
     if args.frames < 0:
         raise ShadeLabError(f"--frames {args.frames}: expected a count >= 0")
+    if args.bench_page_down < 0:
+        raise ShadeLabError(f"--bench-page-down {args.bench_page_down}: expected a count >= 0")
     _check_study_and_case(args)
     if args.pipeline:
         from shadelab.pipelines import viewport_names

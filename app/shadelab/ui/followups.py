@@ -8,7 +8,7 @@ The Viewer (:mod:`shadelab.ui.app`) holds one :class:`FollowUps`; no GL here.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Callable
 
 from shadelab.lab.state import AppState
@@ -35,7 +35,8 @@ class ViewerOptions:
     maximized: bool = False               # open maximized (no --window given)
     pipeline: str = ""                    # viewport pipeline at start (shadelab.ui.pipelines)
     test_function: Callable | None = None  # immapp.testing test body (GUI tests)
-    page_down: bool = False               # bench: PageDown once the lesson step has settled
+    page_down: int = 0                    # bench: PageDown this many times, each once the
+    #                                       lesson step (and its prefetch) has settled
 
 
 def lesson_offline(state: AppState) -> bool:
@@ -73,7 +74,8 @@ class FollowUps:
     options: ViewerOptions
     job_followed_up: bool = False
     study_done_at: int = 0             # frame the --study run ended
-    page_down_s: float | None = None   # bench: when the scripted PageDown happened
+    page_down_s: float | None = None   # bench: when the (first) scripted PageDown happened
+    page_downs_s: list = field(default_factory=list)   # bench: every scripted PageDown
     settled_at: int = 0                # bench: frame the step (and its prefetch) settled
     page_down_at: int = 0              # bench: frame of that PageDown
 
@@ -108,7 +110,8 @@ class FollowUps:
                                          or state.offline.version != runner.version)
         waiting = waiting or bool((options.pipeline or lesson_offline(state))
                                   and pipelines.busy(state))
-        if options.page_down and (self.page_down_s is None or state.frame < self.page_down_at + 3):
+        if options.page_down and (len(self.page_downs_s) < int(options.page_down)
+                                  or state.frame < self.page_down_at + 3):
             self.press_page_down(state)
             waiting = True    # (after it: the new step's job is polled on the next frame)
         if state.studies.run is not None:
@@ -121,14 +124,17 @@ class FollowUps:
         return waiting
 
     def press_page_down(self, state: AppState) -> bool:
-        """Bench (``--bench-page-down``): PageDown once the step's job and the next step's
-        prefetch are done and a few frames have passed; True once pressed."""
+        """Bench (``--bench-page-down [N]``): PageDown once the step's job and the next
+        step's prefetch are done and a few frames have passed, N times (the lesson walked
+        without a restart); True once every press is done."""
         import time
 
         from shadelab.lab.lesson import next_step
 
-        if self.page_down_s is not None:
+        if len(self.page_downs_s) >= int(self.options.page_down):
             return True
+        if self.page_downs_s and state.frame < self.page_down_at + 5:
+            return False     # the new step's job has not been asked for yet
         view = state.view.pipeline_view
         idle = view is None or view.runner is None or not view.runner.running  # (warm-up)
         settled = idle and state.frame >= 10 and not pipelines.busy(state) \
@@ -140,13 +146,16 @@ class FollowUps:
             self.settled_at = state.frame
         if state.frame < self.settled_at + 5:
             return False
-        self.page_down_s = pipelines.since_start(time.perf_counter())
-        self.page_down_at = state.frame
+        now = pipelines.since_start(time.perf_counter())
+        self.page_down_s = now if self.page_down_s is None else self.page_down_s
+        self.page_downs_s.append(now)
+        self.page_down_at, self.settled_at = state.frame, 0
         next_step(state)
-        return True
+        return len(self.page_downs_s) >= int(self.options.page_down)
 
     def bench_extra(self) -> dict:
-        return {} if self.page_down_s is None else {"page_down_s": self.page_down_s}
+        return {} if self.page_down_s is None else {"page_down_s": self.page_down_s,
+                                                    "page_downs_s": list(self.page_downs_s)}
 
     def end_frame(self, state: AppState, frame0: int = 0) -> bool:
         """Once a frame: the after-job requests; True when ``--frames`` says quit now
