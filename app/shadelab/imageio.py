@@ -13,7 +13,6 @@ import json
 from pathlib import Path
 
 import numpy as np
-from PIL import Image
 
 from shadelab.errors import ShadeLabError
 from shadelab.paths import OutputSet, same_file
@@ -108,6 +107,8 @@ def _png_writer(path: str, linear: np.ndarray, exposure: float,
                 meta: dict[str, str] | None = None):
     if Path(path).suffix.lower() == ".exr":
         return _exr_writer(path, linear, meta)
+    from PIL import Image  # here: pillow's import is ~20 ms of the viewer's start
+
     image = Image.fromarray(to_srgb8(linear, exposure))
     fmt = IMAGE_FORMATS.get(Path(path).suffix.lower(), "PNG")
     if fmt != "PNG":

@@ -21,9 +21,12 @@ from __future__ import annotations
 import os
 import warnings
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-from PIL import Image, UnidentifiedImageError
+
+if TYPE_CHECKING:   # pillow is imported where an image is read: ~20 ms of the viewer's start
+    from PIL import Image
 
 from shadelab.errors import ShadeLabError
 from shadelab.paths import file_problem
@@ -77,6 +80,8 @@ def srgb_to_linear(c: np.ndarray) -> np.ndarray:
 def _open_checked(full: Path, key: str) -> Image.Image:
     """Image.open (the header only) with our size check in place of PIL's bomb check, whose
     error names neither the limit nor how to raise it."""
+    from PIL import Image
+
     saved = Image.MAX_IMAGE_PIXELS
     Image.MAX_IMAGE_PIXELS = None
     try:
@@ -95,6 +100,8 @@ def _open_checked(full: Path, key: str) -> Image.Image:
 
 def check_image_file(path: str, base_dir: str, key: str) -> tuple[int, int]:
     """Read only the header: the file is an image within the size limit; its (w, h)."""
+    from PIL import UnidentifiedImageError
+
     full = _resolve(path, base_dir, key)
     try:
         with _open_checked(full, key) as image:
@@ -109,6 +116,8 @@ def check_image_file(path: str, base_dir: str, key: str) -> tuple[int, int]:
 
 def load_image(path: str, base_dir: str, key: str, height: bool = False) -> np.ndarray:
     """(H, W, 3) linear RGB or (H, W) height in [0, 1], float32, row 0 at the BOTTOM (GL's v)."""
+    from PIL import UnidentifiedImageError
+
     full = _resolve(path, base_dir, key)
     try:
         with _open_checked(full, key) as image:
