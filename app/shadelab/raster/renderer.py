@@ -24,6 +24,7 @@ from shadelab.gl.programs import (
 )
 from shadelab.gl.target import RenderTarget
 from shadelab.gl.vertex import soup_vertex_array, triangle_soup
+from shadelab.raster.memo import memoized
 from shadelab.raster.painter import draw_painter
 from shadelab.raster.textures import TextureCache, has_surface_detail
 from shadelab.raster.transparency import draw_transparent
@@ -592,12 +593,8 @@ class Renderer:
         per geometry), with the eye outside its bounding box grown by the reach of the near
         plane (else the near plane could cut a front face away and show the inside: the
         Cornell room, a camera inside a sphere)."""
-        outward = self._outward.get(gpu.key)
-        if outward is None:
-            outward = _closed_outward(gpu.mesh.vertices, gpu.mesh.faces)
-            if len(self._outward) > 256:
-                self._outward.clear()
-            self._outward[gpu.key] = outward
+        outward = memoized(self._outward, gpu.key, lambda: _closed_outward(
+            gpu.mesh.vertices, gpu.mesh.faces), 256)
         return outward and eye_outside(gpu.bounds, scene, size)
 
     def _batch(self, run: list[GpuMesh]) -> GpuMesh:

@@ -39,10 +39,13 @@ from shadelab.geometry.silhouette import (
     shadows_nothing,
 )
 from shadelab.gl.programs import load_program, set_uniform
+from shadelab.raster.memo import memoized
 from shadelab.scene.camera import gl_matrix
 from shadelab.scene.model import Light, Scene
 from shadelab.shading.lights import light_kind
 
+RECENT = 64        # memoized answers kept per light and geometry set (then started again)
+GEOMETRIES = 256   # memoized answers kept per mesh geometry
 OFFSET_FRACTION = 1e-3  # open casters' volumes start this share of the scene's diagonal away
 VOLUME_COLOR = (0.25, 0.45, 1.0, 0.18)  # translucent volumes (linear RGB, alpha)
 # glPolygonOffset(factor, units) for the drawn volumes: behind the caster surface they lie on
@@ -217,7 +220,8 @@ class ShadowVolumes:
         the other meshes' boxes as receivers; memoized on every mesh's geometry."""
         key = (tuple(g.key for g in members), tuple(g.key for g in gpu_meshes),
                light_key(light), offset)
-        if key not in self._occluders:
+
+        def compute() -> PlanarOccluder | None:
             vertices, faces, normals, base = [], [], [], 0
             for g in members:
                 vertices.append(g.mesh.vertices)
@@ -225,27 +229,21 @@ class ShadowVolumes:
                 normals.append(g.mesh.face_normals)
                 base += len(g.mesh.vertices)
             receivers = [g.bounds for g in gpu_meshes if not any(g is m for m in members)]
-            if len(self._occluders) > 64:
-                self._occluders.clear()
-            self._occluders[key] = planar_occluder(
-                np.concatenate(vertices), np.concatenate(faces), np.concatenate(normals),
-                homogeneous, receivers, offset, 1e-6 * offset)
-        return self._occluders[key]
+            return planar_occluder(np.concatenate(vertices), np.concatenate(faces),
+                                   np.concatenate(normals), homogeneous, receivers, offset,
+                                   1e-6 * offset)
+
+        return memoized(self._occluders, key, compute, RECENT)
 
     def _skipped(self, gpu_meshes, light: Light, homogeneous: np.ndarray,
                  offset: float) -> list[bool]:
         """:func:`shadows_nothing` of each mesh for this light, memoized on the light and
         every mesh's geometry (the receivers' boxes): it runs again only after an edit."""
         key = (tuple(g.key for g in gpu_meshes), light_key(light), offset)
-        skipped = self._skips.get(key)
-        if skipped is None:
-            skipped = [shadows_nothing(gpu.mesh.vertices, gpu.mesh.face_normals, homogeneous,
-                                       [g.bounds for g in gpu_meshes if g is not gpu], offset)
-                       for gpu in gpu_meshes]
-            if len(self._skips) > 64:
-                self._skips.clear()
-            self._skips[key] = skipped
-        return skipped
+        return memoized(self._skips, key, lambda: [
+            shadows_nothing(gpu.mesh.vertices, gpu.mesh.face_normals, homogeneous,
+                            [g.bounds for g in gpu_meshes if g is not gpu], offset)
+            for gpu in gpu_meshes], RECENT)
 
     def _cached(self, slot: tuple, key: tuple, object_index: int, build, counted=None,
                 bounds: np.ndarray | None = None) -> CasterVolume:
@@ -270,34 +268,18 @@ class ShadowVolumes:
 
     def _groups(self, grouped: list) -> list[list[int]]:
         """:func:`open_caster_groups` of these meshes, memoized on their geometry keys."""
-        keys = tuple(g.key for g in grouped)
-        groups = self._grouping.get(keys)
-        if groups is None:
-            groups = open_caster_groups([g.mesh.vertices for g in grouped])
-            if len(self._grouping) > 64:
-                self._grouping.clear()
-            self._grouping[keys] = groups
-        return groups
+        return memoized(self._grouping, tuple(g.key for g in grouped),
+                        lambda: open_caster_groups([g.mesh.vertices for g in grouped]), RECENT)
 
     def _is_closed(self, gpu) -> bool:
         """Does the object's mesh make a closed caster (a silhouette volume)? Memoized."""
-        closed = self._closed.get(gpu.key)
-        if closed is None:
-            closed = closed_caster(gpu.mesh.vertices, gpu.mesh.faces) is not None
-            if len(self._closed) > 256:   # geometry edited many times: start again
-                self._closed.clear()
-            self._closed[gpu.key] = closed
-        return closed
+        return memoized(self._closed, gpu.key, lambda: closed_caster(
+            gpu.mesh.vertices, gpu.mesh.faces) is not None, GEOMETRIES)
 
     def _is_convex(self, gpu) -> bool:
         """Is the object's mesh a convex closed caster? Memoized per geometry."""
-        convex = self._convex.get(gpu.key)
-        if convex is None:
-            convex = is_convex(gpu.mesh.vertices, gpu.mesh.faces)
-            if len(self._convex) > 256:
-                self._convex.clear()
-            self._convex[gpu.key] = convex
-        return convex
+        return memoized(self._convex, gpu.key,
+                        lambda: is_convex(gpu.mesh.vertices, gpu.mesh.faces), GEOMETRIES)
 
     def _upload(self, key: tuple, object_index: int, volume: ShadowVolume) -> CasterVolume:
         vbo = self.ctx.buffer(volume.triangles().tobytes())
