@@ -209,6 +209,12 @@ def test_seed_out_of_range(tmp_path, capsys, seed):
     assert "expected an integer in [0, 2**63 - 1]" in one_error(capsys, argv)
 
 
+@pytest.mark.parametrize("flag, value", [("--frames", "-1"), ("--bench-page-down", "-1")])
+def test_view_counts_below_zero_are_refused_before_the_window(capsys, flag, value):
+    argv = ["view", "--lesson", "phong-to-radiosity", flag, value]
+    assert f"{flag} {value}: expected a count >= 0" in one_error(capsys, argv)
+
+
 # ---------------------------------------------------------------- 4. meshes and images
 
 
