@@ -153,8 +153,12 @@ vec3 shade_light(int i, vec3 position, vec3 n, vec3 to_eye, vec3 od) {
     if (kind == LIGHT_SPOT)
         spot = spot_factor(to_light, u_light_direction[i], u_light_spot[i].x, u_light_spot[i].y);
     float specular;
+#ifdef NO_SPECULAR  // the renderer's twin for ks = 0 (or the term off): ks Os times the lobe is 0
+    specular = 0.0;
+#else
     if (SPECULAR_MODEL == SPECULAR_BLINN) specular = blinn_phong_specular(n, to_light, to_eye, u_n);
     else specular = phong_specular(n, to_light, to_eye, u_n);
+#endif
 #ifdef TERMINATOR  // the shadow-volume lit pass; elsewhere no term
     float s = LIGHT_S(i) * terminator_softening(dot(n, to_light), terminator_t);
 #else

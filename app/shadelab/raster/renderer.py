@@ -48,6 +48,12 @@ TEXTURED_PROGRAMS = {name: f"{name}_tex" for name in SHADING_PROGRAMS}
 # The programs whose Od is the material's u_Od: compiled with PREMULTIPLIED (lighting.glsl), so
 # the per-material, per-light factors are folded here once instead of read per fragment.
 PREMULTIPLIED = {"PREMULTIPLIED": 1}
+# Materials whose specular term is 0 everywhere (ks = 0, or the term switched off) are drawn
+# with a "<program>:diffuse" twin compiled with NO_SPECULAR (lighting.glsl): the lobe's pow is
+# never evaluated, and the image is the same bit for bit (its product with ks Os = 0 was +0).
+# False: every material with the full program (for A/B measurements and tests)
+DIFFUSE_VARIANTS = True
+DIFFUSE_SUFFIX = ":diffuse"
 # Opaque closed meshes seen from outside are drawn with their back faces culled
 # (Renderer.cullable); False draws every face (for A/B measurements and tests)
 BACK_FACE_CULLING = True
@@ -64,14 +70,23 @@ class ProgramVariant(dict):
         self.defines = defines
 
     def __missing__(self, name: str) -> moderngl.Program:
-        if name in TEXTURED_PROGRAMS.values():
+        base, _, twin = name.partition(DIFFUSE_SUFFIX[0])
+        if twin and twin != DIFFUSE_SUFFIX[1:]:
+            raise KeyError(name)
+        if base in TEXTURED_PROGRAMS.values() and not twin:
             program = load_program(self.ctx, name, self.defines)
-        elif name in SHADING_PROGRAMS:
+        elif base in SHADING_PROGRAMS:
             # ShadeLab's lighting chunk: the plain programs premultiplied; a replaced chunk (a
-            # student's, registered by load_program as it compiles) reads its own uniforms
+            # student's, registered by load_program as it compiles) reads its own uniforms and
+            # knows no NO_SPECULAR: its diffuse twin is its own program, not compiled again
             gl_programs.register_includes(self.ctx)
-            fast = PREMULTIPLIED if stock_include(self.ctx, "lighting") else {}
-            program = load_program(self.ctx, name, {**self.defines, **fast})
+            stock = stock_include(self.ctx, "lighting")
+            if twin and not stock:
+                program = self[base]
+            else:
+                fast = PREMULTIPLIED if stock else {}
+                diffuse = {"NO_SPECULAR": 1} if twin else {}
+                program = load_program(self.ctx, base, {**self.defines, **fast, **diffuse})
         else:
             raise KeyError(name)
         self[name] = program
@@ -155,6 +170,8 @@ class Renderer:
         self._bounds: tuple | None = None  # (mesh ids, their union box, the meshes)
         self._batches: dict[tuple, GpuMesh] = {}  # runs of meshes of one material, merged
         self._detail = False  # a material of the scene drawn has surface detail (render)
+        self._twins = False   # the frame draws ks = 0 materials with the diffuse twins
+        self._diffuse = False  # ... and a material of the scene drawn is one (render)
         self.light_signature: tuple = ((), "phong")
         self._variant_key: tuple = (self.light_signature, False)
         self.programs = self.programs_for_lights([], "phong")
@@ -255,14 +272,24 @@ class Renderer:
     # ------------------------------------------------------------ uniforms
     def variants(self, shading: str) -> list[moderngl.Program]:
         """The shading mode's program and, where a material has surface detail, its textured
-        variant: the programs this frame's passes draw with."""
+        variant, and where a material has no specular term, its diffuse twin: the programs
+        this frame's passes draw with."""
+        names = [shading]
+        if self._diffuse:
+            names.append(shading + DIFFUSE_SUFFIX)
         if self._detail:
-            return [self.programs[shading], self.programs[TEXTURED_PROGRAMS[shading]]]
-        return [self.programs[shading]]
+            names.append(TEXTURED_PROGRAMS[shading])
+        return [self.programs[name] for name in names]
 
     def program_for(self, shading: str, material: Material) -> str:
-        """Name of the program that draws ``material`` in ``shading`` mode."""
-        return TEXTURED_PROGRAMS[shading] if has_surface_detail(material) else shading
+        """Name of the program that draws ``material`` in ``shading`` mode: the textured one
+        for surface detail, the diffuse twin where the specular term is 0 everywhere
+        (:func:`diffuse_only`), else the mode's own."""
+        if has_surface_detail(material):
+            return TEXTURED_PROGRAMS[shading]
+        if self._twins and diffuse_only(material, self.terms_off):
+            return shading + DIFFUSE_SUFFIX
+        return shading
 
     def use_material(self, scene: Scene, name: str, shading: str) -> str:
         """Set one material's uniforms (and textures) on its program; returns the program name."""
@@ -381,6 +408,10 @@ class Renderer:
         settings = scene.render
         gpu_meshes = self.sync(scene)
         self._detail = any(has_surface_detail(m) for m in scene.materials.values())
+        self._twins = DIFFUSE_VARIANTS
+        self._diffuse = self._twins and any(
+            diffuse_only(m, self.terms_off) and not has_surface_detail(m)
+            for m in scene.materials.values())
         lights = scene.active_lights()[:MAX_LIGHTS]
         self.use_lights(lights, specular)
         painter = settings.visibility == "painter"
@@ -702,6 +733,12 @@ def _union_bounds(boxes: list[np.ndarray]) -> np.ndarray | None:
         return None
     stacked = np.stack(boxes)
     return np.stack([stacked[:, 0].min(axis=0), stacked[:, 1].max(axis=0)])
+
+
+def diffuse_only(material: Material, terms_off: int = 0) -> bool:
+    """No specular term anywhere on ``material``: ks = 0, or the term switched off
+    (``terms_off``, TERM_BITS). Its lobe need not be evaluated: ks Os times it is 0."""
+    return material.ks == 0.0 or bool(terms_off & TERM_BITS["specular"])
 
 
 def is_transparent(material: Material) -> bool:
