@@ -30,8 +30,9 @@ FAIRNESS = ("both sides: the same scene's triangles (scene_meshes) in the same o
             "test on, one clear and one ctx.finish() per frame, timed A B A B ... after 3 warm-up "
             "pairs; ours: Renderer.render (Phong, the preset's lights and materials; the back "
             "faces of closed meshes seen from outside culled, as the renderer always does: the "
-            "80k-triangle sphere's ratio is below 1 for that; materials with ks = 0, all of cornell's, "
-            "drawn by the diffuse twin with no specular lobe, bit-identical); bare: one VAO of position + "
+            "80k-triangle sphere's ratio is below 1 for that; materials with ks = 0, all of "
+            "cornell's, drawn by the diffuse twin with no specular lobe, bit-identical); bare: "
+            "one VAO of position + "
             "normal, one point light, a minimal per-fragment Phong program (ks a uniform: its "
             "lobe is evaluated on every fragment), every face drawn "
             "(cornell's room is seen from inside: nothing of it is culled)")
