@@ -22,34 +22,20 @@ uniform int u_clipping;         // 1: stripe the pixels clamping cuts (a channel
 #define CLIPPING u_clipping
 #endif
 
+#include "color"   // to_srgb_display and heat: conventions.py's encodings, mirrored
+
 in vec2 v_uv;
 out vec4 f_color;
-
-vec3 to_srgb(vec3 linear) {
-    vec3 c = clamp(linear, 0.0, 1.0);
-    vec3 lo = 12.92 * c;
-    vec3 hi = 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055;
-    return mix(hi, lo, vec3(lessThanEqual(c, vec3(0.0031308))));
-}
-
-// Black -> blue -> green -> yellow -> red as t goes 0 -> 1.
-vec3 heat(float t) {
-    float s = clamp(t, 0.0, 1.0) * 4.0;
-    if (s < 1.0) return mix(vec3(0.0), vec3(0.0, 0.0, 1.0), s);
-    if (s < 2.0) return mix(vec3(0.0, 0.0, 1.0), vec3(0.0, 1.0, 0.0), s - 1.0);
-    if (s < 3.0) return mix(vec3(0.0, 1.0, 0.0), vec3(1.0, 1.0, 0.0), s - 2.0);
-    return mix(vec3(1.0, 1.0, 0.0), vec3(1.0, 0.0, 0.0), s - 3.0);
-}
 
 void main() {
     vec3 a = texture(t_image, v_uv).rgb * u_exposure;
     if (MODE == 1) {
         vec3 b = texture(t_other, v_uv).rgb * u_exposure;
         vec3 d = abs(a - b);
-        f_color = vec4(heat(max(d.r, max(d.g, d.b)) / max(u_diff_scale, 1e-12)), 1.0);
+        f_color = vec4(heat(max(d.r, max(d.g, d.b)) / max(u_diff_scale, HEAT_EPS)), 1.0);
     } else {
         vec3 mapped = TONEMAP == 1 ? a / (1.0 + a) : a;
-        vec3 rgb = to_srgb(mapped);
+        vec3 rgb = to_srgb_display(mapped);
         if (CLIPPING == 1 && TONEMAP == 0 && max(a.r, max(a.g, a.b)) > 1.0) {
             // magenta / black diagonal stripes, 8 pixels apart: readable from the back row
             float stripe = mod(floor((gl_FragCoord.x + gl_FragCoord.y) / 4.0), 2.0);

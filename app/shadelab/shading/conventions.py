@@ -18,6 +18,16 @@ SRGB_SLOPE = 12.92  # the linear segment's slope
 SRGB_SCALE = 1.055  # the power segment: SCALE * c^(1 / GAMMA) - OFFSET
 SRGB_OFFSET = 0.055
 SRGB_GAMMA = 2.4
+# The display pass's encoding (shaders/include/color.glsl to_srgb_display): the power segment
+# as a degree-8 polynomial in t = c^(1/4) (two square roots, eight multiply-adds per channel;
+# llvmpipe's pow is a log2 and an exp2 approximation, ~4 ms of a 1024x672 frame). Coefficients
+# in float32, lowest order first: a least-squares Chebyshev fit of SCALE t^(4/GAMMA) - OFFSET on
+# [SRGB_LINEAR_MAX^(1/4), 1], within 7e-5 of an 8-bit code everywhere (tests/shaders/
+# test_display_encoding.py refits it); a code differs from to_srgb8's only where the exact
+# value lies that close to a rounding threshold (1.5e-5 of values, by 1).
+SRGB_POLY = (-0.05783136934041977, 0.11321315169334412, 1.5348799228668213, -1.4410881996154785,
+             1.8761974573135376, -1.8614805936813354, 1.2348675727844238, -0.4821125566959381,
+             0.0833546593785286)
 # The difference heat map: black -> blue -> green -> yellow -> red as t goes 0 -> 1
 HEAT_STOPS = ((0.0, 0.0, 0.0), (0.0, 0.0, 1.0), (0.0, 1.0, 0.0), (1.0, 1.0, 0.0), (1.0, 0.0, 0.0))
 HEAT_EPS = 1e-12  # guard of the heat map's full-scale difference
@@ -46,6 +56,19 @@ def to_srgb8(linear: np.ndarray, exposure: float = 1.0) -> np.ndarray:
     return np.round(srgb * 255.0).astype(np.uint8)
 
 
+def display_srgb8(linear: np.ndarray, exposure: float = 1.0) -> np.ndarray:
+    """:func:`to_srgb8` as the display pass computes it (color.glsl ``to_srgb_display``): in
+    float32, the power segment by :data:`SRGB_POLY` in c^(1/4), rounded as a unorm8 write."""
+    x = np.asarray(linear, dtype=np.float32) * np.float32(exposure)
+    c = np.clip(np.nan_to_num(x, nan=0.0, posinf=1.0), 0.0, 1.0).astype(np.float32)
+    t = np.sqrt(np.sqrt(c))
+    power = np.zeros_like(t)
+    for coefficient in np.float32(SRGB_POLY)[::-1]:
+        power = power * t + coefficient
+    srgb = np.where(c <= np.float32(SRGB_LINEAR_MAX), np.float32(SRGB_SLOPE) * c, power)
+    return np.floor(srgb * np.float32(255.0) + np.float32(0.5)).astype(np.uint8)
+
+
 def heat_map(a: np.ndarray, b: np.ndarray, scale: float) -> np.ndarray:
     """(H, W, 3) uint8: max-channel |a - b| / scale through black-blue-green-yellow-red."""
     t = np.clip(np.abs(a - b).max(axis=-1) / max(scale, HEAT_EPS), 0.0, 1.0) * 4.0
@@ -63,4 +86,5 @@ def glsl_header() -> str:
     lines = [f"#define {name} {value!r}" for name, value in defines.items()]
     lines += [f"#define HEAT_STOP_{k} vec3({', '.join(map(repr, stop))})"
               for k, stop in enumerate(HEAT_STOPS)]
+    lines += [f"#define SRGB_POLY_{k} {value!r}" for k, value in enumerate(SRGB_POLY)]
     return "// Generated from shadelab/shading/conventions.py.\n" + "\n".join(lines) + "\n"
