@@ -87,6 +87,10 @@ PRESENTER_SCALE = 1.8      # font scale of presenter mode
 WARM_JOBS_AT_FRAME = 60    # start the offline-job process once the window is up
 BENCH_SETTLE_S = 30.0     # the bench waits at most this long for the start-up warm-up
 SETTLE_FRAME_S = 0.05     # meanwhile a frame every 50 ms, near an idling viewer's rate
+# The viewport's display pass goes straight into the window, under imgui's draw lists, where
+# the image is shown pixel for pixel (ViewportHost.to_window): imgui's window-sized textured
+# quad of it was ~4.6 ms of a 1024x768 frame on llvmpipe. False: always through the texture
+WINDOW_PASS = True
 WINDOW_BG = imgui.ImVec4(0.06, 0.06, 0.06, 1.0)  # the window's clear before the theme's is known
 
 
@@ -199,6 +203,8 @@ class Viewer:
     recorder: FrameRecorder = field(default_factory=FrameRecorder)  # frame times, the bench
     _line_cache: dict = field(default_factory=dict)
     _frame_key: tuple = ()
+    _window_pass: tuple | None = None     # the viewport's display pass into the window, due
+    last_window_rect: tuple | None = None  # where it went last (x, y from the bottom, w, h)
     warm_after_first_frame: bool = False  # spawn the pipeline worker after the first frame
     bench_frame0: int | None = None       # the bench's phases count from this frame (settled)
     followups: FollowUps = field(init=False)  # what the command line asked for
@@ -297,9 +303,10 @@ class Viewer:
         """Show the texture; handle orbit/pan/zoom; return the clicked pixel, if any."""
         state = self.state
         origin = imgui.get_cursor_screen_pos()
-        imgui.image(imgui.ImTextureRef(texture.glo), imgui.ImVec2(*size),
-                    uv0=imgui.ImVec2(0, 1), uv1=imgui.ImVec2(1, 0))
-        imgui.set_cursor_screen_pos(origin)
+        if texture is not None:   # None: drawn into the window under imgui (to_window)
+            imgui.image(imgui.ImTextureRef(texture.glo), imgui.ImVec2(*size),
+                        uv0=imgui.ImVec2(0, 1), uv1=imgui.ImVec2(1, 0))
+            imgui.set_cursor_screen_pos(origin)
         if gizmos.wants_mouse():  # ImGuizmo activates only when no item is hovered
             imgui.dummy(imgui.ImVec2(*size))
             return None
@@ -355,8 +362,15 @@ class Viewer:
             return
         display_size, size = size, self.render_size(size)
         if "main" in vp.panes and self.unchanged(size):
-            self._handle_click(self.image_with_input(vp.panes["main"].display, display_size),
-                               display_size)
+            pane = vp.panes["main"]
+            if pane.shown is not None and self.to_window(pane, *pane.shown, display_size):
+                texture = None
+            else:
+                if pane.display_pending is not None:
+                    vp.present(pane, pane.display_pending[0], tonemap=pane.display_pending[1],
+                               clipping=pane.display_pending[2])
+                texture = pane.display
+            self._handle_click(self.image_with_input(texture, display_size), display_size)
             return
         self.recorder.begin("scene")  # the bench's breakdown: PASS 1-5 (read-backs apart)
         # --- PASS 1-2: the scene into the float target (the Renderer's passes), or the solved
@@ -393,14 +407,47 @@ class Viewer:
             lines = overlays.ray_tree_lines(state.offline.ray_tree, overlays.scene_diagonal(meshes))
             vp.draw_lines(pane, lines, exposure, depth_test=False)
         # --- PASS 5: exposure, tone map + sRGB for display
-        texture = vp.present(pane, exposure, tonemap=state.view.tonemap,
-                             clipping=state.view.show_clipping)
+        texture = None
+        if size != display_size or not self.to_window(pane, exposure, state.view.tonemap,
+                                                      state.view.show_clipping, display_size):
+            texture = vp.present(pane, exposure, tonemap=state.view.tonemap,
+                                 clipping=state.view.show_clipping)
+            at = imgui.get_cursor_screen_pos()   # where image_with_input puts it: whole pixels?
+            vp.sample_one_to_one(pane, size == display_size and at.x.is_integer()
+                                 and at.y.is_integer())
         if state.screenshot_requested:
             with self.recorder.part("readback"):
                 write_viewport_screenshot(state, vp, state.screenshot_requested)
             state.screenshot_requested = ""
         self.recorder.end("scene")
         self._handle_click(self.image_with_input(texture, display_size), display_size)
+
+    def to_window(self, pane, exposure: float, tonemap: str, clipping: bool,
+                  display_size: tuple[int, int]) -> bool:
+        """Show ``pane`` by a display pass straight into the window, under imgui's draw lists
+        (:meth:`present_window_pass`, before ImGui renders), instead of its texture drawn by
+        imgui: where the pane is shown pixel for pixel at whole-pixel window coordinates, with
+        the window's framebuffer at the GUI's scale. Returns whether it will be."""
+        io = imgui.get_io()
+        at = imgui.get_cursor_screen_pos()
+        if not (WINDOW_PASS and self.viewport.ctx.screen is not None
+                and pane.size == tuple(display_size)
+                and at.x.is_integer() and at.y.is_integer()
+                and io.display_framebuffer_scale.x == 1.0
+                and io.display_framebuffer_scale.y == 1.0):
+            return False
+        height = int(io.display_size.y)
+        rect = (int(at.x), height - int(at.y) - pane.size[1], *pane.size)
+        self._window_pass = (pane, exposure, tonemap, clipping, rect)
+        return True
+
+    def present_window_pass(self) -> None:
+        """The viewport's display pass into the window (before_imgui_render), if one is due."""
+        due, self._window_pass = self._window_pass, None
+        if due is not None and self.viewport is not None:
+            pane, exposure, tonemap, clipping, rect = due
+            self.last_window_rect = rect
+            self.viewport.present_to_window(pane, exposure, tonemap, clipping, rect)
 
     def samples(self) -> int:
         """MSAA samples of the scene pass: the Display panel's choice, within the GL's limit."""
@@ -655,7 +702,8 @@ def runner_params(viewer: Viewer) -> hello_imgui.RunnerParams:
     # ImGui's draw lists drawn and the swap (FrameRecorder.frame_swapped ends that part)
     params.callbacks.pre_new_frame = lambda: viewer.recorder.begin("gui")
     params.callbacks.before_imgui_render = lambda: (viewer.recorder.end("gui"),
-                                                    viewer.recorder.begin("gui_render"))
+                                                    viewer.recorder.begin("gui_render"),
+                                                    viewer.present_window_pass())
     params.callbacks.show_gui = lambda: guarded(viewer.end_frame, "frame", viewer.report_error)
     return params
 

@@ -29,6 +29,12 @@ class Pane:
     display_fbo: moderngl.Framebuffer
     view: View | None = None
     samples_asked: int = 1
+    display_filter: tuple = (moderngl.LINEAR, moderngl.LINEAR)  # as the display texture's
+    # present's settings for this pane ((exposure, tone map, clipping)) while ``display`` does
+    # not hold them yet: the last display pass went straight to the window
+    # (Viewport.present_to_window); read_display draws the texture first
+    display_pending: tuple | None = None
+    shown: tuple | None = None   # (exposure, tone map, clipping) of its last display pass
 
     @property
     def size(self) -> tuple[int, int]:
@@ -151,11 +157,38 @@ class Viewport:
         """Display pass into ``pane``'s RGBA8 texture: exposure, tone map (clamp | reinhard),
         sRGB of ``source`` (default the pane itself), or the |source - other| heat map when
         ``other`` is given; ``clipping`` stripes the pixels the clamp cuts."""
+        pane.display_pending = None
+        if other is None and source is None:
+            pane.shown = (exposure, tonemap, clipping)
+        pane.display_fbo.use()
+        self._display_pass(pane, exposure, source, other, diff_scale, tonemap, clipping)
+        return pane.display
+
+    def present_to_window(self, pane: Pane, exposure: float, tonemap: str, clipping: bool,
+                          rect: tuple[int, int, int, int]) -> None:
+        """The display pass of ``pane`` drawn straight into the window's framebuffer at
+        ``rect`` (x, y from the bottom left, width, height: the pane's own size), the bytes
+        :meth:`present` writes into the texture; imgui then draws nothing there, a
+        window-sized textured quad less per frame (issue 25). The texture is left as it was
+        (``display_pending``) until something reads it (:meth:`read_display`)."""
+        pane.display_pending = pane.shown = (exposure, tonemap, clipping)
+        screen = self.ctx.screen
+        screen.use()
+        before = screen.viewport
+        screen.viewport = rect
+        try:
+            self._display_pass(pane, exposure, None, None, 0.05, tonemap, clipping)
+        finally:
+            screen.viewport = before
+
+    def _display_pass(self, pane: Pane, exposure: float, source: Pane | None,
+                      other: Pane | None, diff_scale: float, tonemap: str,
+                      clipping: bool) -> None:
+        """The display program over the bound framebuffer's viewport."""
         source = source or pane
         source.target.resolve()
         if other is not None:
             other.target.resolve()
-        pane.display_fbo.use()
         self.ctx.enable_only(moderngl.NOTHING)
         source.target.color.use(0)
         (other or source).target.color.use(1)
@@ -167,7 +200,16 @@ class Viewport:
         set_uniform(program, "u_diff_scale", float(diff_scale))
         vao.render(moderngl.TRIANGLES, vertices=3)
         self.restore()
-        return pane.display
+
+    @staticmethod
+    def sample_one_to_one(pane: Pane, one_to_one: bool) -> None:
+        """The filter imgui samples ``pane``'s display texture with: NEAREST where it is shown
+        pixel for pixel (each fragment reads its own texel, as LINEAR did at the texel's centre,
+        for less of llvmpipe's time), LINEAR where it is scaled up (a render scale < 1)."""
+        want = (moderngl.NEAREST, moderngl.NEAREST) if one_to_one else \
+            (moderngl.LINEAR, moderngl.LINEAR)
+        if pane.display_filter != want:
+            pane.display.filter = pane.display_filter = want
 
     def display_variant(self, mode: int, tonemap: int, clipping: int):
         """The display program compiled for one (mode, tone map, clipping) and its VAO (made on
@@ -195,6 +237,9 @@ class Viewport:
     def read_display(self, key: str) -> np.ndarray:
         """What the pane shows: (H, W, 3) uint8 sRGB, row 0 at the top."""
         pane = self.panes[key]
+        if pane.display_pending is not None:   # shown in the window only: the texture too
+            exposure, tonemap, clipping = pane.display_pending
+            self.present(pane, exposure, tonemap=tonemap, clipping=clipping)
         w, h = pane.size
         data = np.frombuffer(pane.display.read(), dtype=np.uint8).reshape(h, w, 4)
         return np.ascontiguousarray(data[::-1, :, :3])
