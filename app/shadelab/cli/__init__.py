@@ -108,7 +108,15 @@ def main(argv: list[str] | None = None) -> int:
     rest = argv[len(lead):]
     if not rest or (rest[0] not in COMMANDS and rest[0] not in ("-h", "--help", "--version")):
         argv = [*lead, "view", *rest]  # 'shadelab [PRESET] [view options]' opens the viewer
-    parser = build_parser(argv[len(lead)])
+    from shadelab import startup
+
+    if argv[len(lead)] == "view":
+        startup.pause_gc()  # until the viewer's first frame (shadelab.startup)
+    try:
+        parser = build_parser(argv[len(lead)])
+    except BaseException:
+        startup.resume_gc()
+        raise
     saved_allow = os.environ.get(ALLOW_ENV)
     saved_term = None
     from shadelab import progress
@@ -167,6 +175,7 @@ def main(argv: list[str] | None = None) -> int:
               "was written", file=sys.stderr)
         return EXIT_IO_ERROR
     finally:
+        startup.resume_gc()  # a view that ended before its first frame (a bad flag, no display)
         progress.QUIET = saved_quiet
         if saved_term is not None:
             signal.signal(signal.SIGTERM, saved_term)

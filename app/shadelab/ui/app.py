@@ -28,6 +28,7 @@ from shadelab.lab.state import (
     AppState,
 )
 from shadelab.shading.codes import terms_mask
+from shadelab.startup import resume_gc
 from shadelab.ui import (
     compare_view,
     equation_panel,
@@ -84,6 +85,7 @@ studies_panel = LazyPanels("studies_panel")
 ray_tree_panel = LazyPanels("ray_tree_panel")
 
 PRESENTER_SCALE = 1.8      # font scale of presenter mode
+GC_RESUME_FRAME = 3        # the garbage collector runs again by then, first frame or not
 WARM_JOBS_AT_FRAME = 60    # start the offline-job process once the window is up
 BENCH_SETTLE_S = 30.0     # the bench waits at most this long for the start-up warm-up
 SETTLE_FRAME_S = 0.05     # meanwhile a frame every 50 ms, near an idling viewer's rate
@@ -572,7 +574,10 @@ class Viewer:
 
     def frame_swapped(self) -> None:
         """After the frame is on screen (:meth:`FrameRecorder.frame_swapped`)."""
-        if self.recorder.frame_swapped() and self.warm_after_first_frame:
+        first = self.recorder.frame_swapped()
+        if first or self.state.frame >= GC_RESUME_FRAME:
+            resume_gc()   # paused by 'shadelab view' for the start-up (shadelab.startup)
+        if first and self.warm_after_first_frame:
             pipelines.warm(self.state)  # the job process imports while the user looks
 
     def update_title(self) -> None:

@@ -1,0 +1,96 @@
+"""The viewer's start-up: the garbage collector paused from 'shadelab view' to the first frame
+(shadelab.startup), and always running again afterwards."""
+
+from __future__ import annotations
+
+import gc
+
+import pytest
+
+from shadelab import startup
+from shadelab.cli import main
+from shadelab.errors import ShadeLabError
+from shadelab.lab.state import AppState
+from shadelab.scene import load_preset
+
+
+@pytest.fixture(autouse=True)
+def _collector_back_on():
+    yield
+    startup.resume_gc()
+    gc.enable()
+
+
+def test_pause_and_resume_turn_the_collector_off_and_on():
+    assert gc.isenabled()
+    startup.pause_gc()
+    assert not gc.isenabled() and startup.gc_paused()
+    startup.resume_gc()
+    assert gc.isenabled() and not startup.gc_paused()
+
+
+def test_a_collector_the_caller_turned_off_stays_off():
+    gc.disable()
+    startup.pause_gc()
+    startup.resume_gc()
+    assert not gc.isenabled()
+
+
+def test_view_pauses_the_collector_and_a_bad_preset_resumes_it(monkeypatch, capsys):
+    """Paused while the view command loads its scene; on again when it fails before a window."""
+    from shadelab.scene import preset
+
+    seen = []
+
+    def failing_load(name, overrides=()):
+        seen.append(gc.isenabled())
+        raise ShadeLabError(f"unknown preset '{name}'")
+
+    monkeypatch.setattr(preset, "load_preset", failing_load)
+    monkeypatch.setenv("DISPLAY", ":12345")  # never reached
+    assert main(["view", "no-such-preset", "--fresh"]) == 2
+    assert seen == [False]
+    assert gc.isenabled() and not startup.gc_paused()
+    assert "unknown preset" in capsys.readouterr().err
+
+
+def test_other_commands_leave_the_collector_on(monkeypatch, capsys, tmp_path):
+    from shadelab.scene import preset
+
+    seen = []
+
+    def failing_load(name, overrides=()):
+        seen.append(gc.isenabled())
+        raise ShadeLabError(f"unknown preset '{name}'")
+
+    monkeypatch.setattr(preset, "load_preset", failing_load)
+    assert main(["render", "no-such-preset", "-o", str(tmp_path / "never.png")]) == 2
+    assert seen == [True]
+    assert gc.isenabled()
+
+
+def _viewer():
+    from shadelab.ui.app import Viewer, ViewerOptions
+
+    return Viewer(AppState.from_scene(load_preset("cornell"), "cornell"), ViewerOptions())
+
+
+def test_the_first_frame_on_screen_resumes_the_collector():
+    viewer = _viewer()
+    startup.pause_gc()
+    viewer.frame_swapped()                 # the dock space only: no scene yet
+    assert not gc.isenabled()
+    viewer.recorder.viewport_shown = True
+    viewer.frame_swapped()                 # the first frame
+    assert gc.isenabled() and not startup.gc_paused()
+
+
+def test_the_collector_resumes_even_without_a_first_frame():
+    from shadelab.ui.app import GC_RESUME_FRAME
+
+    viewer = _viewer()
+    startup.pause_gc()
+    for frame in range(GC_RESUME_FRAME + 1):
+        viewer.state.frame = frame
+        viewer.frame_swapped()
+    assert gc.isenabled()
