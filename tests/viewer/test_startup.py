@@ -94,3 +94,22 @@ def test_the_collector_resumes_even_without_a_first_frame():
         viewer.state.frame = frame
         viewer.frame_swapped()
     assert gc.isenabled()
+
+
+def test_the_bench_holds_back_no_frame_before_the_first(monkeypatch):
+    """While the bench waits for the warm-up it paces frames as an idle viewer does, from the
+    first frame on screen: the frames before it are not slept on."""
+    import time
+
+    from shadelab.ui import app
+    from shadelab.ui.app import Viewer, ViewerOptions
+
+    slept = []
+    monkeypatch.setattr(time, "sleep", slept.append)
+    viewer = Viewer(AppState.from_scene(load_preset("cornell"), "cornell"),
+                    ViewerOptions(frames=5, bench_json="unused.json"))
+    viewer.warm_after_first_frame = True   # the warm-up has not started: not settled
+    assert viewer.bench_phase(viewer.state) == 1 and slept == []
+    viewer.recorder.viewport_shown = True
+    viewer.recorder.frame_swapped()        # the first frame is on screen
+    assert viewer.bench_phase(viewer.state) == 1 and slept == [app.SETTLE_FRAME_S]

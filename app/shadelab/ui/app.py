@@ -567,7 +567,10 @@ class Viewer:
                 recorder.settled = time.perf_counter()
         recorder.settling = self.bench_frame0 is None
         if self.bench_frame0 is None:
-            time.sleep(SETTLE_FRAME_S)   # as an idle viewer does (fps idling): the warm-up's core
+            # as an idle viewer does (fps idling), leaving the warm-up its core; not before the
+            # first frame is on screen (the warm-up starts after it; the sleep only delayed it)
+            if recorder.first_frame:
+                time.sleep(SETTLE_FRAME_S)
             return state.frame + 1
         recorder.set_phase(state.frame - self.bench_frame0, self.options.frames)
         return self.bench_frame0
