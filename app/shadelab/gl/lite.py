@@ -1,7 +1,11 @@
 """The few raw-GL calls ShadeLab makes beside moderngl (render targets' depth-stencil
-renderbuffers, stencil state, the constant blend color), from PyOpenGL's raw per-version
-modules: ``from OpenGL import GL`` builds a wrapper for every entry point of every GL version
-and extension (~150 ms of a viewer's start on two cores); these few import in about half.
+renderbuffers, stencil state, the constant blend color), made as PyOpenGL's raw modules make
+them: ``from OpenGL import GL`` builds a wrapper for every entry point of every GL version
+and extension (~150 ms of a viewer's start on two cores), and even the raw per-version modules
+(``OpenGL.raw.GL.VERSION.GL_1_0`` ...) build ~600 entry points and ~2000 constants for the two
+dozen used here (~25 ms more); each entry point below is declared as its raw module declares
+it (the same ``createFunction`` on the same platform library, argument types and error
+checker), the rest never built.
 
 Each call is checked as PyOpenGL's own wrappers are: a GL error raises (PyOpenGL's GLError
 where its raw functions check errors, else :class:`GLCallError` naming the call). The
@@ -14,7 +18,150 @@ from __future__ import annotations
 import ctypes
 
 import numpy as np
-from OpenGL.raw.GL.VERSION import GL_1_0, GL_1_1, GL_1_4, GL_2_0, GL_3_0
+from OpenGL import arrays
+from OpenGL import platform as _p
+from OpenGL.raw.GL import _errors
+from OpenGL.raw.GL import _types as _cs
+
+
+def _in(version: str):
+    """Declare an entry point of GL ``version`` as ``OpenGL.raw.GL.VERSION.GL_<version>``
+    does (its ``_f``)."""
+    def declare(function):
+        return _p.createFunction(function, _p.PLATFORM.GL, f"GL_VERSION_GL_{version}",
+                                 error_checker=_errors._error_checker)
+    return declare
+
+
+# ---------------------------------------------------------------- entry points (PyOpenGL raw)
+# the argument lists of PyOpenGL 3.1's generated OpenGL/raw/GL/VERSION/GL_*.py
+
+
+class raw:
+    """PyOpenGL's raw entry points (its own error checker only; the checked calls of this
+    module are below): ``raw.glClear`` is ``OpenGL.raw.GL.VERSION.GL_1_0.glClear``."""
+
+    @_in("1_0")
+    @_p.types(None,)
+    def glFlush(): pass
+
+    @_in("1_0")
+    @_p.types(None, _cs.GLenum)
+    def glEnable(cap): pass
+
+    @_in("1_0")
+    @_p.types(None, _cs.GLenum)
+    def glDisable(cap): pass
+
+    @_in("1_0")
+    @_p.types(None, _cs.GLbitfield)
+    def glClear(mask): pass
+
+    @_in("1_0")
+    @_p.types(None, _cs.GLint)
+    def glClearStencil(s): pass
+
+    @_in("1_0")
+    @_p.types(None, _cs.GLenum, _cs.GLint, _cs.GLuint)
+    def glStencilFunc(func, ref, mask): pass
+
+    @_in("1_0")
+    @_p.types(None, _cs.GLuint)
+    def glStencilMask(mask): pass
+
+    @_in("1_0")
+    @_p.types(None, _cs.GLenum, _cs.GLenum, _cs.GLenum)
+    def glStencilOp(fail, zfail, zpass): pass
+
+    @_in("1_0")
+    @_p.types(None, _cs.GLenum, _cs.GLenum)
+    def glBlendFunc(sfactor, dfactor): pass
+
+    @_in("1_0")
+    @_p.types(_cs.GLenum,)
+    def glGetError(): pass
+
+    @_in("1_0")
+    @_p.types(None, _cs.GLenum, arrays.GLintArray)
+    def glGetIntegerv(pname, data): pass
+
+    @_in("1_0")
+    @_p.types(None, _cs.GLenum, _cs.GLint)
+    def glPixelStorei(pname, param): pass
+
+    @_in("1_0")
+    @_p.types(None, _cs.GLint, _cs.GLint, _cs.GLsizei, _cs.GLsizei, _cs.GLenum, _cs.GLenum,
+              ctypes.c_void_p)
+    def glReadPixels(x, y, width, height, format, type, pixels): pass
+
+    @_in("1_1")
+    @_p.types(None, _cs.GLfloat, _cs.GLfloat)
+    def glPolygonOffset(factor, units): pass
+
+    @_in("1_4")
+    @_p.types(None, _cs.GLfloat, _cs.GLfloat, _cs.GLfloat, _cs.GLfloat)
+    def glBlendColor(red, green, blue, alpha): pass
+
+    @_in("2_0")
+    @_p.types(None, _cs.GLenum, _cs.GLenum, _cs.GLenum, _cs.GLenum)
+    def glStencilOpSeparate(face, sfail, dpfail, dppass): pass
+
+    @_in("3_0")
+    @_p.types(None, _cs.GLenum, _cs.GLuint)
+    def glBindRenderbuffer(target, renderbuffer): pass
+
+    @_in("3_0")
+    @_p.types(None, _cs.GLenum, _cs.GLenum, _cs.GLsizei, _cs.GLsizei)
+    def glRenderbufferStorage(target, internalformat, width, height): pass
+
+    @_in("3_0")
+    @_p.types(None, _cs.GLenum, _cs.GLsizei, _cs.GLenum, _cs.GLsizei, _cs.GLsizei)
+    def glRenderbufferStorageMultisample(target, samples, internalformat, width,
+                                         height): pass
+
+    @_in("3_0")
+    @_p.types(None, _cs.GLenum, _cs.GLuint)
+    def glBindFramebuffer(target, framebuffer): pass
+
+    @_in("3_0")
+    @_p.types(None, _cs.GLenum, _cs.GLenum, _cs.GLenum, _cs.GLuint, _cs.GLint)
+    def glFramebufferTexture2D(target, attachment, textarget, texture, level): pass
+
+    @_in("3_0")
+    @_p.types(None, _cs.GLenum, _cs.GLenum, _cs.GLenum, _cs.GLuint)
+    def glFramebufferRenderbuffer(target, attachment, renderbuffertarget,
+                                  renderbuffer): pass
+
+    @_in("3_0")
+    @_p.types(None, _cs.GLint, _cs.GLint, _cs.GLint, _cs.GLint, _cs.GLint, _cs.GLint,
+              _cs.GLint, _cs.GLint, _cs.GLbitfield, _cs.GLenum)
+    def glBlitFramebuffer(srcX0, srcY0, srcX1, srcY1, dstX0, dstY0, dstX1, dstY1,
+                          mask, filter): pass
+
+    @_in("3_0")
+    @_p.types(_cs.GLenum, _cs.GLenum)
+    def glCheckFramebufferStatus(target): pass
+
+    @_in("3_0")
+    @_p.types(None, _cs.GLsizei, arrays.GLuintArray)
+    def glGenRenderbuffers(n, renderbuffers): pass
+
+    @_in("3_0")
+    @_p.types(None, _cs.GLsizei, arrays.GLuintArray)
+    def glGenFramebuffers(n, framebuffers): pass
+
+    @_in("3_0")
+    @_p.types(None, _cs.GLsizei, arrays.GLuintArray)
+    def glDeleteRenderbuffers(n, renderbuffers): pass
+
+    @_in("3_0")
+    @_p.types(None, _cs.GLsizei, arrays.GLuintArray)
+    def glDeleteFramebuffers(n, framebuffers): pass
+
+    @_in("4_2")
+    @_p.types(None, _cs.GLenum, _cs.GLenum, _cs.GLenum, _cs.GLsizei, arrays.GLintArray)
+    def glGetInternalformativ(target, internalformat, pname, count, params): pass
+
 
 GL_NO_ERROR = 0
 GL_NEVER, GL_LESS, GL_EQUAL, GL_LEQUAL = 0x0200, 0x0201, 0x0202, 0x0203
@@ -46,7 +193,7 @@ def _checked(function):
 
     def call(*args):
         result = function(*args)
-        error = GL_1_0.glGetError()
+        error = raw.glGetError()
         if error != GL_NO_ERROR:
             raise GLCallError(f"{name}{args}: GL error 0x{int(error):04x}")
         return result
@@ -55,68 +202,75 @@ def _checked(function):
     return call
 
 
-glFlush = _checked(GL_1_0.glFlush)
-glEnable = _checked(GL_1_0.glEnable)
-glDisable = _checked(GL_1_0.glDisable)
-glClear = _checked(GL_1_0.glClear)
-glClearStencil = _checked(GL_1_0.glClearStencil)
-glStencilFunc = _checked(GL_1_0.glStencilFunc)
-glStencilMask = _checked(GL_1_0.glStencilMask)
-glStencilOp = _checked(GL_1_0.glStencilOp)
-glStencilOpSeparate = _checked(GL_2_0.glStencilOpSeparate)
-glPolygonOffset = _checked(GL_1_1.glPolygonOffset)
-glBlendFunc = _checked(GL_1_0.glBlendFunc)
-glBlendColor = _checked(GL_1_4.glBlendColor)
-glBindRenderbuffer = _checked(GL_3_0.glBindRenderbuffer)
-glRenderbufferStorage = _checked(GL_3_0.glRenderbufferStorage)
-glRenderbufferStorageMultisample = _checked(GL_3_0.glRenderbufferStorageMultisample)
-glBindFramebuffer = _checked(GL_3_0.glBindFramebuffer)
-glFramebufferTexture2D = _checked(GL_3_0.glFramebufferTexture2D)
-glFramebufferRenderbuffer = _checked(GL_3_0.glFramebufferRenderbuffer)
-glBlitFramebuffer = _checked(GL_3_0.glBlitFramebuffer)
-_check_status = _checked(GL_3_0.glCheckFramebufferStatus)
+glFlush = _checked(raw.glFlush)
+glEnable = _checked(raw.glEnable)
+glDisable = _checked(raw.glDisable)
+glClear = _checked(raw.glClear)
+glClearStencil = _checked(raw.glClearStencil)
+glStencilFunc = _checked(raw.glStencilFunc)
+glStencilMask = _checked(raw.glStencilMask)
+glStencilOp = _checked(raw.glStencilOp)
+glStencilOpSeparate = _checked(raw.glStencilOpSeparate)
+glPolygonOffset = _checked(raw.glPolygonOffset)
+glBlendFunc = _checked(raw.glBlendFunc)
+glBlendColor = _checked(raw.glBlendColor)
+glBindRenderbuffer = _checked(raw.glBindRenderbuffer)
+glRenderbufferStorage = _checked(raw.glRenderbufferStorage)
+glRenderbufferStorageMultisample = _checked(raw.glRenderbufferStorageMultisample)
+glBindFramebuffer = _checked(raw.glBindFramebuffer)
+glFramebufferTexture2D = _checked(raw.glFramebufferTexture2D)
+glFramebufferRenderbuffer = _checked(raw.glFramebufferRenderbuffer)
+glBlitFramebuffer = _checked(raw.glBlitFramebuffer)
+_check_status = _checked(raw.glCheckFramebufferStatus)
 
 
 def glCheckFramebufferStatus(target: int) -> int:
     return int(_check_status(target))
 
 
+# Arrays are passed as ctypes arrays: a numpy one loads PyOpenGL's numpy handler, which imports
+# the raw GL_1_1 and GL_1_0 modules (~15 ms of the viewer's start) for its type constants.
+
+
+def _uints(values) -> ctypes.Array:
+    values = np.asarray(values, dtype=np.uint32).ravel()
+    return (ctypes.c_uint * len(values))(*(int(v) for v in values))
+
+
 def _gen(function, n: int):
-    names = np.zeros(n, dtype=np.uint32)
+    names = (ctypes.c_uint * n)()
     _checked(function)(n, names)
     return int(names[0]) if n == 1 else [int(v) for v in names]
 
 
 def glGenRenderbuffers(n: int):
     """``n`` new renderbuffer names (an int for one, as PyOpenGL returns)."""
-    return _gen(GL_3_0.glGenRenderbuffers, n)
+    return _gen(raw.glGenRenderbuffers, n)
 
 
 def glGenFramebuffers(n: int):
-    return _gen(GL_3_0.glGenFramebuffers, n)
+    return _gen(raw.glGenFramebuffers, n)
 
 
 def glDeleteRenderbuffers(n: int, names) -> None:
-    _checked(GL_3_0.glDeleteRenderbuffers)(n, np.asarray(names, dtype=np.uint32))
+    _checked(raw.glDeleteRenderbuffers)(n, _uints(names))
 
 
 def glDeleteFramebuffers(n: int, names) -> None:
-    _checked(GL_3_0.glDeleteFramebuffers)(n, np.asarray(names, dtype=np.uint32))
+    _checked(raw.glDeleteFramebuffers)(n, _uints(names))
 
 
 def glGetIntegerv(pname: int) -> int:
-    value = np.zeros(16, dtype=np.int32)   # room for any vector query
-    _checked(GL_1_0.glGetIntegerv)(pname, value)
+    value = (ctypes.c_int * 16)()   # room for any vector query
+    _checked(raw.glGetIntegerv)(pname, value)
     return int(value[0])
 
 
 def glGetInternalformativ(target: int, internal_format: int, pname: int, count: int):
     """The query's ``count`` integers (GL 4.2; GLCallError where the GL lacks it)."""
-    from OpenGL.raw.GL.VERSION import GL_4_2
-
-    values = np.zeros(max(count, 1), dtype=np.int32)
-    _checked(GL_4_2.glGetInternalformativ)(target, internal_format, pname, count, values)
-    return values
+    values = (ctypes.c_int * max(count, 1))()
+    _checked(raw.glGetInternalformativ)(target, internal_format, pname, count, values)
+    return np.array(values, dtype=np.int32)
 
 
 def glReadPixels(x: int, y: int, width: int, height: int, format: int, kind: int) -> bytes:
@@ -124,6 +278,6 @@ def glReadPixels(x: int, y: int, width: int, height: int, format: int, kind: int
     if kind != GL_UNSIGNED_BYTE or format != GL_STENCIL_INDEX:
         raise ValueError("glReadPixels here reads GL_STENCIL_INDEX as GL_UNSIGNED_BYTE only")
     out = (ctypes.c_ubyte * (width * height))()
-    GL_1_0.glPixelStorei(0x0D05, 1)   # GL_PACK_ALIGNMENT: rows of any width packed tight
-    _checked(GL_1_0.glReadPixels)(x, y, width, height, format, kind, out)
+    raw.glPixelStorei(0x0D05, 1)   # GL_PACK_ALIGNMENT: rows of any width packed tight
+    _checked(raw.glReadPixels)(x, y, width, height, format, kind, out)
     return bytes(out)

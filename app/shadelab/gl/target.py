@@ -18,9 +18,7 @@ def _gl():
 
 
 def _raw_gl():
-    from OpenGL.raw.GL.VERSION import GL_1_0  # unchecked calls (see RenderTarget.clear)
-
-    return GL_1_0
+    return _gl().raw  # PyOpenGL's raw entry points, unchecked here (see RenderTarget.clear)
 
 
 def bind_anchor(ctx: moderngl.Context) -> None:
