@@ -113,3 +113,32 @@ def test_the_bench_holds_back_no_frame_before_the_first(monkeypatch):
     viewer.recorder.viewport_shown = True
     viewer.recorder.frame_swapped()        # the first frame is on screen
     assert viewer.bench_phase(viewer.state) == 1 and slept == [app.SETTLE_FRAME_S]
+
+
+@pytest.mark.gl
+def test_the_overlay_programs_compile_when_first_drawn(gl_ctx):
+    """A first frame without overlays compiles no line program; the first wireframe compiles
+    the thin lines', thick lines the quads' (and both draw)."""
+    import numpy as np
+
+    from shadelab.ui.viewport import Viewport
+
+    vp = Viewport(gl_ctx)
+    try:
+        scene = load_preset("cornell")
+        pane = vp.draw_scene("main", scene, (64, 48), "phong", "blinn")
+        assert vp._lines is None and vp._thick is None
+        before = pane.target.read().copy()
+        segment = np.array([[50, 270, 280, 1, 0, 0], [500, 280, 280, 1, 0, 0]], dtype=np.float32)
+        vp.draw_lines(pane, segment, 1.0, depth_test=False)
+        assert vp._lines is not None and vp._thick is None
+        thin = pane.target.read().copy()
+        assert np.any(thin != before)
+        vp.line_width = 3.0
+        vp.draw_lines(pane, segment, 1.0, depth_test=False)
+        assert vp._thick is not None
+        assert np.count_nonzero(np.any(pane.target.read() != before, axis=2)) > \
+            np.count_nonzero(np.any(thin != before, axis=2))
+    finally:
+        vp.release()
+    assert vp._lines is None and vp._thick is None

@@ -52,21 +52,34 @@ class Viewport:
     def __init__(self, ctx: moderngl.Context):
         self.ctx = ctx
         self.renderer = Renderer(ctx)
-        self.lines_program = load_program(ctx, "lines")
         self._display_variants: dict[tuple, tuple] = {}  # (mode, tonemap, clip): program, vao
         self.panes: dict[str, Pane] = {}
         self.images: dict[str, moderngl.Texture] = {}  # CPU images (offline results)
         self._anchor = ctx.simple_framebuffer((1, 1))
-        self._line_buffer = ctx.buffer(reserve=1 << 20, dynamic=True)
-        self._line_vao = ctx.vertex_array(self.lines_program,
-                                          [(self._line_buffer, "3f 3f", "in_position", "in_color")])
         self.line_width = 1.0  # overlay lines, pixels of the target (> 1: drawn as quads)
-        self.thick_program = load_program(ctx, "thick_lines")
-        self._thick_buffer = ctx.buffer(reserve=1 << 20, dynamic=True)
-        self._thick_vao = ctx.vertex_array(
-            self.thick_program,
-            [(self._thick_buffer, "3f 3f 3f 1f", "in_position", "in_other", "in_color",
-              "in_side")])
+        # the overlay programs (program, buffer, vertex array), made when first drawn: most
+        # first frames draw no overlay, and each compile is a few ms of the start on llvmpipe
+        self._lines: tuple | None = None
+        self._thick: tuple | None = None
+
+    def _line_pass(self) -> tuple:
+        """(program, buffer, vertex array) of the thin overlay lines (shaders/lines.*)."""
+        if self._lines is None:
+            program = load_program(self.ctx, "lines")
+            buffer = self.ctx.buffer(reserve=1 << 20, dynamic=True)
+            self._lines = (program, buffer, self.ctx.vertex_array(
+                program, [(buffer, "3f 3f", "in_position", "in_color")]))
+        return self._lines
+
+    def _thick_pass(self) -> tuple:
+        """(program, buffer, vertex array) of the lines drawn as quads (shaders/thick_lines.*)."""
+        if self._thick is None:
+            program = load_program(self.ctx, "thick_lines")
+            buffer = self.ctx.buffer(reserve=1 << 20, dynamic=True)
+            self._thick = (program, buffer, self.ctx.vertex_array(
+                program, [(buffer, "3f 3f 3f 1f", "in_position", "in_other", "in_color",
+                           "in_side")]))
+        return self._thick
 
     def restore(self) -> None:
         """Bind the window's framebuffer again (imgui draws there), or a 1x1 anchor headless.
@@ -123,33 +136,33 @@ class Viewport:
             self._draw_thick(pane, lines, exposure, depth_test, bias)
             return
         data = np.ascontiguousarray(lines, dtype=np.float32).tobytes()
-        if len(data) > self._line_buffer.size:
-            self._line_buffer.orphan(len(data) * 2)
-        self._line_buffer.write(data)
+        program, buffer, vao = self._line_pass()
+        if len(data) > buffer.size:
+            buffer.orphan(len(data) * 2)
+        buffer.write(data)
         pane.target.use()
         self.ctx.enable_only(moderngl.DEPTH_TEST if depth_test else moderngl.NOTHING)
-        program = self.lines_program
         set_uniform(program, "u_clip_from_world", gl_matrix(pane.view.clip_from_world))
         set_uniform(program, "u_depth_bias", bias if depth_test else 0.0)
         set_uniform(program, "u_scale", 1.0 / max(exposure, 1e-12))
-        self._line_vao.render(mode, vertices=len(lines))
+        vao.render(mode, vertices=len(lines))
 
     def _draw_thick(self, pane: Pane, lines: np.ndarray, exposure: float, depth_test: bool,
                     bias: float) -> None:
         """Segments as quads ``self.line_width`` pixels wide (see shaders/thick_lines.vert)."""
         data = np.ascontiguousarray(thick_line_vertices(lines), dtype=np.float32).tobytes()
-        if len(data) > self._thick_buffer.size:
-            self._thick_buffer.orphan(len(data) * 2)
-        self._thick_buffer.write(data)
+        program, buffer, vao = self._thick_pass()
+        if len(data) > buffer.size:
+            buffer.orphan(len(data) * 2)
+        buffer.write(data)
         pane.target.use()
         self.ctx.enable_only(moderngl.DEPTH_TEST if depth_test else moderngl.NOTHING)
-        program = self.thick_program
         set_uniform(program, "u_clip_from_world", gl_matrix(pane.view.clip_from_world))
         set_uniform(program, "u_depth_bias", bias if depth_test else 0.0)
         set_uniform(program, "u_scale", 1.0 / max(exposure, 1e-12))
         set_uniform(program, "u_viewport", tuple(float(c) for c in pane.size))
         set_uniform(program, "u_width", float(self.line_width))
-        self._thick_vao.render(moderngl.TRIANGLES, vertices=len(lines) // 2 * 6)
+        vao.render(moderngl.TRIANGLES, vertices=len(lines) // 2 * 6)
 
     def present(self, pane: Pane, exposure: float, source: Pane | None = None,
                 other: Pane | None = None, diff_scale: float = 0.05, tonemap: str = "clamp",
@@ -270,16 +283,17 @@ class Viewport:
         self.panes.clear()
         for tex in self.images.values():
             tex.release()
-        self._line_vao.release()
-        self._line_buffer.release()
-        self._thick_vao.release()
-        self._thick_buffer.release()
-        self.thick_program.release()
+        for made in (self._lines, self._thick):
+            if made is not None:
+                program, buffer, vao = made
+                vao.release()
+                buffer.release()
+                program.release()
+        self._lines = self._thick = None
         for program, vao in self._display_variants.values():
             vao.release()
             program.release()
         self._display_variants.clear()
-        self.lines_program.release()
         self.renderer.release()
         (self.ctx.screen or self.ctx.detect_framebuffer(0)).use()
         self._anchor.release()
