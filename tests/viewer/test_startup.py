@@ -55,7 +55,7 @@ def test_view_pauses_the_collector_and_a_bad_preset_resumes_it(monkeypatch, caps
 
 
 def test_other_commands_leave_the_collector_on(monkeypatch, capsys, tmp_path):
-    from shadelab.scene import preset
+    from shadelab.cli import render
 
     seen = []
 
@@ -63,7 +63,7 @@ def test_other_commands_leave_the_collector_on(monkeypatch, capsys, tmp_path):
         seen.append(gc.isenabled())
         raise ShadeLabError(f"unknown preset '{name}'")
 
-    monkeypatch.setattr(preset, "load_preset", failing_load)
+    monkeypatch.setattr(render, "load_preset", failing_load)   # bound there at import
     assert main(["render", "no-such-preset", "-o", str(tmp_path / "never.png")]) == 2
     assert seen == [True]
     assert gc.isenabled()
