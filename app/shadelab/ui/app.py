@@ -207,6 +207,7 @@ class Viewer:
     _frame_key: tuple = ()
     _window_pass: tuple | None = None     # the viewport's display pass into the window, due
     last_window_rect: tuple | None = None  # where it went last (x, y from the bottom, w, h)
+    window_passes: dict = field(default_factory=lambda: {"display": 0, "copy": 0})  # so far
     warm_after_first_frame: bool = False  # spawn the pipeline worker after the first frame
     bench_frame0: int | None = None       # the bench's phases count from this frame (settled)
     followups: FollowUps = field(init=False)  # what the command line asked for
@@ -365,7 +366,8 @@ class Viewer:
         display_size, size = size, self.render_size(size)
         if "main" in vp.panes and self.unchanged(size):
             pane = vp.panes["main"]
-            if pane.shown is not None and self.to_window(pane, *pane.shown, display_size):
+            if pane.shown is not None and self.to_window(pane, *pane.shown, display_size,
+                                                         idle=True):
                 texture = None
             else:
                 if pane.display_pending is not None:
@@ -425,11 +427,12 @@ class Viewer:
         self._handle_click(self.image_with_input(texture, display_size), display_size)
 
     def to_window(self, pane, exposure: float, tonemap: str, clipping: bool,
-                  display_size: tuple[int, int]) -> bool:
+                  display_size: tuple[int, int], idle: bool = False) -> bool:
         """Show ``pane`` by a display pass straight into the window, under imgui's draw lists
         (:meth:`present_window_pass`, before ImGui renders), instead of its texture drawn by
         imgui: where the pane is shown pixel for pixel at whole-pixel window coordinates, with
-        the window's framebuffer at the GUI's scale. Returns whether it will be."""
+        the window's framebuffer at the GUI's scale; ``idle`` (the image unchanged): its
+        display texture copied there instead. Returns whether it will be."""
         io = imgui.get_io()
         at = imgui.get_cursor_screen_pos()
         if not (WINDOW_PASS and self.viewport.ctx.screen is not None
@@ -440,16 +443,20 @@ class Viewer:
             return False
         height = int(io.display_size.y)
         rect = (int(at.x), height - int(at.y) - pane.size[1], *pane.size)
-        self._window_pass = (pane, exposure, tonemap, clipping, rect)
+        self._window_pass = (pane, exposure, tonemap, clipping, rect, idle)
         return True
 
     def present_window_pass(self) -> None:
         """The viewport's display pass into the window (before_imgui_render), if one is due."""
         due, self._window_pass = self._window_pass, None
         if due is not None and self.viewport is not None:
-            pane, exposure, tonemap, clipping, rect = due
+            pane, exposure, tonemap, clipping, rect, idle = due
             self.last_window_rect = rect
-            self.viewport.present_to_window(pane, exposure, tonemap, clipping, rect)
+            self.window_passes["copy" if idle else "display"] += 1
+            if idle:
+                self.viewport.blit_to_window(pane, rect)
+            else:
+                self.viewport.present_to_window(pane, exposure, tonemap, clipping, rect)
 
     def samples(self) -> int:
         """MSAA samples of the scene pass: the Display panel's choice, within the GL's limit."""

@@ -194,6 +194,24 @@ class Viewport:
         finally:
             screen.viewport = before
 
+    def blit_to_window(self, pane: Pane, rect: tuple[int, int, int, int]) -> None:
+        """``pane``'s display texture copied into the window's framebuffer at ``rect`` (an idle
+        frame: the image did not change). After a window pass the texture is drawn first,
+        once; then each idle frame is a copy, cheaper than a display pass or imgui's quad."""
+        from shadelab.gl import lite
+
+        if pane.display_pending is not None:
+            exposure, tonemap, clipping = pane.display_pending
+            self.present(pane, exposure, tonemap=tonemap, clipping=clipping)
+        w, h = pane.size
+        x, y = rect[0], rect[1]
+        _ = self.ctx.error
+        lite.glBindFramebuffer(lite.GL_READ_FRAMEBUFFER, pane.display_fbo.glo)
+        lite.glBindFramebuffer(lite.GL_DRAW_FRAMEBUFFER, 0)
+        lite.glBlitFramebuffer(0, 0, w, h, x, y, x + w, y + h, lite.GL_COLOR_BUFFER_BIT,
+                               lite.GL_NEAREST)
+        self.restore()   # moderngl's record of the bound framebuffer stays true
+
     def _display_pass(self, pane: Pane, exposure: float, source: Pane | None,
                       other: Pane | None, diff_scale: float, tonemap: str,
                       clipping: bool) -> None:
