@@ -125,6 +125,46 @@ def _pathtrace(size: tuple[int, int], spp: int, sampler: str = "sobol"):
                     "tracer": tracer}
 
 
+# Dr.Jit's LLVM backend loads the first libLLVM it finds; an old one (Mesa's LLVM 15) aborts
+# the process at its first kernel. A test render in a child process first: a failure there is
+# a named skip of the comparison, not the end of the whole bench.
+MITSUBA_PROBE = ("import drjit as dr, mitsuba as mi\n"
+                 "mi.set_variant('llvm_ad_rgb')\n"
+                 "scene = mi.load_dict({'type': 'scene', 'integrator': {'type': 'path'},"
+                 " 'sphere': {'type': 'sphere'},"
+                 " 'light': {'type': 'constant'}, 'sensor': {'type': 'perspective',"
+                 " 'film': {'type': 'hdrfilm', 'width': 8, 'height': 8}}})\n"
+                 "dr.eval(mi.render(scene, spp=1)); dr.sync_thread()\n")
+MITSUBA_PROBE_TIMEOUT_S = 180
+_mitsuba_usable: dict = {}
+
+
+def mitsuba_usable(python: str | None = None) -> str | None:
+    """None when Mitsuba 3's ``llvm_ad_rgb`` variant renders (in a child process: a crash of
+    Dr.Jit's LLVM backend ends only that); else why not, in one line, with the fix."""
+    import subprocess
+    import sys
+
+    python = python or sys.executable
+    if python in _mitsuba_usable:
+        return _mitsuba_usable[python]
+    try:
+        proc = subprocess.run([python, "-c", MITSUBA_PROBE], capture_output=True, text=True,
+                              timeout=MITSUBA_PROBE_TIMEOUT_S)
+        why = None
+        if proc.returncode != 0:
+            lines = [line for line in proc.stderr.strip().splitlines() if line.strip()]
+            last = lines[-1][:200] if lines else ""
+            why = (f"a test render with Mitsuba's llvm_ad_rgb variant failed (exit "
+                   f"{proc.returncode}{': ' + last if last else ''}); Dr.Jit's LLVM backend needs "
+                   f"a recent libLLVM: apt-get install libllvm19")
+    except subprocess.TimeoutExpired:
+        why = (f"a test render with Mitsuba's llvm_ad_rgb variant took over "
+               f"{MITSUBA_PROBE_TIMEOUT_S} s")
+    _mitsuba_usable[python] = why
+    return why
+
+
 def _mitsuba(size, spp: int, sampler: str = "independent"):
     """Mitsuba 3's ``path`` integrator (NEE + MIS + Russian roulette, max_depth -1) on the
     same Cornell box: our preset's triangles, diffuse reflectances kd * Od, the emitter's
@@ -138,6 +178,9 @@ def _mitsuba(size, spp: int, sampler: str = "independent"):
         mi.set_variant("llvm_ad_rgb")
     except Exception as exc:  # not installed, or Dr.Jit found no LLVM
         return None, {"available": False, "why": f"{type(exc).__name__}: {exc}"[:300]}
+    why = mitsuba_usable()
+    if why is not None:
+        return None, {"available": False, "why": why}
     from shadelab.geometry.mesh import scene_meshes
 
     scene = load_preset("cornell")
