@@ -127,18 +127,18 @@ def test_the_overlay_programs_compile_when_first_drawn(gl_ctx):
     try:
         scene = load_preset("cornell")
         pane = vp.draw_scene("main", scene, (64, 48), "phong", "blinn")
-        assert vp._lines is None and vp._thick is None
+        assert "lines" not in vp._overlays and "thick_lines" not in vp._overlays
         before = pane.target.read().copy()
         segment = np.array([[50, 270, 280, 1, 0, 0], [500, 280, 280, 1, 0, 0]], dtype=np.float32)
         vp.draw_lines(pane, segment, 1.0, depth_test=False)
-        assert vp._lines is not None and vp._thick is None
+        assert "lines" in vp._overlays and "thick_lines" not in vp._overlays
         thin = pane.target.read().copy()
         assert np.any(thin != before)
         vp.line_width = 3.0
         vp.draw_lines(pane, segment, 1.0, depth_test=False)
-        assert vp._thick is not None
+        assert "thick_lines" in vp._overlays
         assert np.count_nonzero(np.any(pane.target.read() != before, axis=2)) > \
             np.count_nonzero(np.any(thin != before, axis=2))
     finally:
         vp.release()
-    assert vp._lines is None and vp._thick is None
+    assert "lines" not in vp._overlays and "thick_lines" not in vp._overlays

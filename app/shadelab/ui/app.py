@@ -370,10 +370,7 @@ class Viewer:
                                                          idle=True):
                 texture = None
             else:
-                if pane.display_pending is not None:
-                    vp.present(pane, pane.display_pending[0], tonemap=pane.display_pending[1],
-                               clipping=pane.display_pending[2])
-                texture = pane.display
+                texture = vp.display_texture(pane)
             self._handle_click(self.image_with_input(texture, display_size), display_size)
             return
         self.recorder.begin("scene")  # the bench's breakdown: PASS 1-5 (read-backs apart)
@@ -412,13 +409,10 @@ class Viewer:
             vp.draw_lines(pane, lines, exposure, depth_test=False)
         # --- PASS 5: exposure, tone map + sRGB for display
         texture = None
-        if size != display_size or not self.to_window(pane, exposure, state.view.tonemap,
-                                                      state.view.show_clipping, display_size):
+        if not self.to_window(pane, exposure, state.view.tonemap, state.view.show_clipping,
+                              display_size):
             texture = vp.present(pane, exposure, tonemap=state.view.tonemap,
                                  clipping=state.view.show_clipping)
-            at = imgui.get_cursor_screen_pos()   # where image_with_input puts it: whole pixels?
-            vp.sample_one_to_one(pane, size == display_size and at.x.is_integer()
-                                 and at.y.is_integer())
         if state.screenshot_requested:
             with self.recorder.part("readback"):
                 write_viewport_screenshot(state, vp, state.screenshot_requested)

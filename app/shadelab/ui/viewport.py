@@ -29,7 +29,6 @@ class Pane:
     display_fbo: moderngl.Framebuffer
     view: View | None = None
     samples_asked: int = 1
-    display_filter: tuple = (moderngl.LINEAR, moderngl.LINEAR)  # as the display texture's
     # present's settings for this pane ((exposure, tone map, clipping)) while ``display`` does
     # not hold them yet: the last display pass went straight to the window
     # (Viewport.present_to_window); read_display draws the texture first
@@ -57,29 +56,20 @@ class Viewport:
         self.images: dict[str, moderngl.Texture] = {}  # CPU images (offline results)
         self._anchor = ctx.simple_framebuffer((1, 1))
         self.line_width = 1.0  # overlay lines, pixels of the target (> 1: drawn as quads)
-        # the overlay programs (program, buffer, vertex array), made when first drawn: most
-        # first frames draw no overlay, and each compile is a few ms of the start on llvmpipe
-        self._lines: tuple | None = None
-        self._thick: tuple | None = None
+        # the overlay programs (program, buffer, vertex array) by name, made when first drawn:
+        # most first frames draw no overlay, and each compile is a few ms of the start
+        self._overlays: dict[str, tuple] = {}
 
-    def _line_pass(self) -> tuple:
-        """(program, buffer, vertex array) of the thin overlay lines (shaders/lines.*)."""
-        if self._lines is None:
-            program = load_program(self.ctx, "lines")
+    def _overlay_pass(self, name: str, layout: str, *attributes: str) -> tuple:
+        """(program, buffer, vertex array) of the overlay program ``name`` (shaders/name.*),
+        made on first use: thin lines ("lines") or lines drawn as quads ("thick_lines")."""
+        made = self._overlays.get(name)
+        if made is None:
+            program = load_program(self.ctx, name)
             buffer = self.ctx.buffer(reserve=1 << 20, dynamic=True)
-            self._lines = (program, buffer, self.ctx.vertex_array(
-                program, [(buffer, "3f 3f", "in_position", "in_color")]))
-        return self._lines
-
-    def _thick_pass(self) -> tuple:
-        """(program, buffer, vertex array) of the lines drawn as quads (shaders/thick_lines.*)."""
-        if self._thick is None:
-            program = load_program(self.ctx, "thick_lines")
-            buffer = self.ctx.buffer(reserve=1 << 20, dynamic=True)
-            self._thick = (program, buffer, self.ctx.vertex_array(
-                program, [(buffer, "3f 3f 3f 1f", "in_position", "in_other", "in_color",
-                           "in_side")]))
-        return self._thick
+            made = self._overlays[name] = (program, buffer, self.ctx.vertex_array(
+                program, [(buffer, layout, *attributes)]))
+        return made
 
     def restore(self) -> None:
         """Bind the window's framebuffer again (imgui draws there), or a 1x1 anchor headless.
@@ -136,7 +126,7 @@ class Viewport:
             self._draw_thick(pane, lines, exposure, depth_test, bias)
             return
         data = np.ascontiguousarray(lines, dtype=np.float32).tobytes()
-        program, buffer, vao = self._line_pass()
+        program, buffer, vao = self._overlay_pass("lines", "3f 3f", "in_position", "in_color")
         if len(data) > buffer.size:
             buffer.orphan(len(data) * 2)
         buffer.write(data)
@@ -151,7 +141,8 @@ class Viewport:
                     bias: float) -> None:
         """Segments as quads ``self.line_width`` pixels wide (see shaders/thick_lines.vert)."""
         data = np.ascontiguousarray(thick_line_vertices(lines), dtype=np.float32).tobytes()
-        program, buffer, vao = self._thick_pass()
+        program, buffer, vao = self._overlay_pass("thick_lines", "3f 3f 3f 1f", "in_position",
+                                                  "in_other", "in_color", "in_side")
         if len(data) > buffer.size:
             buffer.orphan(len(data) * 2)
         buffer.write(data)
@@ -194,16 +185,22 @@ class Viewport:
         finally:
             screen.viewport = before
 
+    def display_texture(self, pane: Pane) -> moderngl.Texture:
+        """``pane``'s display texture, drawn first if the last display pass went to the window
+        only (``display_pending``)."""
+        if pane.display_pending is not None:
+            exposure, tonemap, clipping = pane.display_pending
+            self.present(pane, exposure, tonemap=tonemap, clipping=clipping)
+        return pane.display
+
     def blit_to_window(self, pane: Pane, rect: tuple[int, int, int, int]) -> None:
         """``pane``'s display texture copied into the window's framebuffer at ``rect`` (an idle
         frame: the image did not change). After a window pass the texture is drawn first,
         once; then each idle frame is a copy, cheaper than a display pass or imgui's quad."""
         from shadelab.gl import lite
 
-        if pane.display_pending is not None:
-            exposure, tonemap, clipping = pane.display_pending
-            self.present(pane, exposure, tonemap=tonemap, clipping=clipping)
-        w, h = pane.size
+        source = self.display_texture(pane)
+        w, h = source.size
         x, y = rect[0], rect[1]
         _ = self.ctx.error
         lite.glBindFramebuffer(lite.GL_READ_FRAMEBUFFER, pane.display_fbo.glo)
@@ -232,16 +229,6 @@ class Viewport:
         vao.render(moderngl.TRIANGLES, vertices=3)
         self.restore()
 
-    @staticmethod
-    def sample_one_to_one(pane: Pane, one_to_one: bool) -> None:
-        """The filter imgui samples ``pane``'s display texture with: NEAREST where it is shown
-        pixel for pixel (each fragment reads its own texel, as LINEAR did at the texel's centre,
-        for less of llvmpipe's time), LINEAR where it is scaled up (a render scale < 1)."""
-        want = (moderngl.NEAREST, moderngl.NEAREST) if one_to_one else \
-            (moderngl.LINEAR, moderngl.LINEAR)
-        if pane.display_filter != want:
-            pane.display.filter = pane.display_filter = want
-
     def display_variant(self, mode: int, tonemap: int, clipping: int):
         """The display program compiled for one (mode, tone map, clipping) and its VAO (made on
         first use): no masked branch runs for the others (shaders/display.frag)."""
@@ -268,11 +255,8 @@ class Viewport:
     def read_display(self, key: str) -> np.ndarray:
         """What the pane shows: (H, W, 3) uint8 sRGB, row 0 at the top."""
         pane = self.panes[key]
-        if pane.display_pending is not None:   # shown in the window only: the texture too
-            exposure, tonemap, clipping = pane.display_pending
-            self.present(pane, exposure, tonemap=tonemap, clipping=clipping)
         w, h = pane.size
-        data = np.frombuffer(pane.display.read(), dtype=np.uint8).reshape(h, w, 4)
+        data = np.frombuffer(self.display_texture(pane).read(), dtype=np.uint8).reshape(h, w, 4)
         return np.ascontiguousarray(data[::-1, :, :3])
 
     def upload_image(self, key: str, image_srgb8: np.ndarray) -> moderngl.Texture:
@@ -301,13 +285,11 @@ class Viewport:
         self.panes.clear()
         for tex in self.images.values():
             tex.release()
-        for made in (self._lines, self._thick):
-            if made is not None:
-                program, buffer, vao = made
-                vao.release()
-                buffer.release()
-                program.release()
-        self._lines = self._thick = None
+        for program, buffer, vao in self._overlays.values():
+            vao.release()
+            buffer.release()
+            program.release()
+        self._overlays.clear()
         for program, vao in self._display_variants.values():
             vao.release()
             program.release()
