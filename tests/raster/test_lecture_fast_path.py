@@ -14,10 +14,13 @@ import trimesh
 import shadelab.raster.renderer as renderer_module
 import shadelab.raster.shadows as shadows_module
 from shadelab.geometry.silhouette import (
+    away_from_light,
+    bounded_volume,
     count_volume,
     is_convex,
     light_homogeneous,
     shadow_volume,
+    volume_sources,
 )
 from shadelab.gl.target import RenderTarget
 from shadelab.raster.renderer import Renderer, _closed_outward
@@ -375,3 +378,121 @@ def test_leaving_out_hidden_volumes_keeps_the_counts(gl_ctx, monkeypatch, eye):
         renderer.release()
     np.testing.assert_array_equal(left_out, every)
     np.testing.assert_array_equal(image, image_all)
+
+
+# ------------------------------------------------------------------ bounded volumes (CPU)
+BOX = np.array([[-6.0, 0.0, -6.0], [6.0, 4.0, 6.0]])   # the receivers' box of these casters
+
+
+def _points_in(box: np.ndarray, rng, count: int) -> np.ndarray:
+    return rng.uniform(box[0], box[1], (count, 3))
+
+
+@pytest.mark.parametrize("caster", sorted(CASTERS))
+@pytest.mark.parametrize("light", [("point", (2.5, 3.5, 2.0)), ("point", (-3.0, 1.5, 0.5)),
+                                   ("directional", (-0.3, -1.0, -0.2)),
+                                   ("directional", (1.0, -0.2, 0.1))])
+def test_bounded_volume_counts_as_the_volume_to_infinity(caster, light, np_rng):
+    """Cut off at a face of the receivers' box, a volume (full caps, and the count volume's
+    fans) winds around every point of the box as often as it did reaching infinity, and its
+    far points all lie on that face, beyond the box."""
+    mesh = CASTERS[caster]()
+    v = np.asarray(mesh.vertices, float) + np.array([0.0, 1.2, 0.0])
+    f = np.asarray(mesh.faces, np.int64)
+    kind, value = light
+    homogeneous = light_homogeneous(kind, value, value)
+    full = shadow_volume(v, f, homogeneous)
+    reduced = count_volume(full, homogeneous, is_convex(v, f))
+    margin = 0.02 * float(np.linalg.norm(np.ptp(BOX, axis=0)))
+    # points all over the box, and many behind the caster from the light (in its shadow)
+    beyond = v[np_rng.integers(0, len(v), 1500)]
+    beyond = beyond + np_rng.uniform(0.0, 6.0, (len(beyond), 1)) * away_from_light(
+        beyond, homogeneous) + np_rng.normal(0.0, 0.1, beyond.shape)
+    points = np.concatenate([_points_in(BOX, np_rng, 1000), beyond])
+    points = points[np.all((points > BOX[0]) & (points < BOX[1]), axis=1)]
+    points = points[~_inside_convex(mesh, points - [0.0, 1.2, 0.0], 1e-6)] \
+        if caster != "torus" else points
+    n = len(full.vertices) // 2
+    fans = np.concatenate([reduced.faces[a:a + k] for a, k in reduced.ranges(True)])
+    for vertices, faces, rows in ((full.vertices, full.faces, volume_sources(n)),
+                                  (reduced.vertices, fans, volume_sources(n, True))):
+        # (infinity as 1e6 away: a directional light's rays stay parallel to 1e-5 here)
+        before = _winding(points, _finite(vertices, homogeneous, 1e6)[faces])
+        assert (before != 0).sum() > 20, "some points of the box lie in the shadow"
+        cut = bounded_volume(vertices, rows, BOX, margin)
+        assert cut is not None
+        bounded, face, reach = cut
+        assert (bounded[:, 3] == 1.0).all()
+        axis, side = divmod(face, 2)
+        far = vertices[:, 3] == 0.0
+        level = BOX[side, axis] + (margin if side else -margin)
+        np.testing.assert_allclose(bounded[far, axis], level)
+        assert 0.0 < reach < 1e3
+        np.testing.assert_array_equal(_counts(bounded, faces, homogeneous, points), before)
+
+
+def test_bounded_volume_refuses_rays_no_face_of_the_box_catches():
+    """A light close to a wide plate facing the box's diagonal sends rays out through
+    three faces, none crossed by all of them: no cut (counted to infinity); a plate
+    reaching beyond the box gets none either."""
+    diagonal = np.ones(3) / np.sqrt(3.0)
+    plate = trimesh.creation.box(extents=(5.0, 0.05, 5.0))
+    plate.apply_transform(trimesh.geometry.align_vectors([0.0, 1.0, 0.0], diagonal))
+    plate.apply_translation(0.3 * diagonal)
+    v, f = np.asarray(plate.vertices, float), np.asarray(plate.faces, np.int64)
+    box = np.array([[-4.0, -4.0, -4.0], [4.0, 4.0, 4.0]])
+    assert np.all(np.abs(v) < 4.0)
+    light = light_homogeneous("point", (0.0, 0.0, 0.0), (0, 0, 0))
+    volume = shadow_volume(v, f, light)
+    n = len(volume.vertices) // 2
+    assert bounded_volume(volume.vertices, volume_sources(n), box, 0.1) is None
+    far_light = light_homogeneous("point", -20.0 * diagonal, (0, 0, 0))
+    volume = shadow_volume(v, f, far_light)
+    assert bounded_volume(volume.vertices, volume_sources(n), box, 0.1) is not None
+    assert bounded_volume(volume.vertices, volume_sources(n), box / 2.0, 0.1) is None
+
+
+# ------------------------------------------------------------------ bounded volumes (GL)
+@pytest.mark.gl
+@pytest.mark.parametrize("preset, overrides", [
+    ("lecture", []), ("lecture", ["camera.eye=[1.465, -1.0, -0.907]"]),
+    ("lecture", [f"camera.eye={PLASTIC_CENTRE}", "camera.target=[0.0, 0.7, -3.0]"]),
+    ("lecture", ["camera.eye=[0.0, 40.0, 60.0]"]), ("shadows", []),
+    ("shadows-colored", []), ("mesh-open", []), ("mesh-spot", []), ("mesh-stl", []),
+    ("fail-open-caster", []), ("multi-lights", []), ("cornell-spheres", []),
+])
+def test_bounded_volumes_keep_the_image(gl_ctx, monkeypatch, preset, overrides):
+    """The z-fail count with the volumes cut off at the receivers' box gives the image the
+    volumes to infinity give, bit for bit, and on the lecture it is the cut geometry that
+    was counted."""
+    scene = load_preset(preset, overrides)
+    monkeypatch.setattr(shadows_module, "BOUNDED_VOLUMES", False)
+    to_infinity, _ = _frame(gl_ctx, scene)
+    monkeypatch.setattr(shadows_module, "BOUNDED_VOLUMES", True)
+    renderer = Renderer(gl_ctx)
+    try:
+        image, _ = _frame(gl_ctx, scene, renderer)
+        shadows = renderer.shadow_volumes
+        used = shadows.bounded_for(renderer._view, scene.render.shadow_method)
+        cut = [v.bounded_vao is not None for v in shadows._cache.values()]
+    finally:
+        renderer.release()
+    if preset == "lecture" and not overrides:
+        assert used and all(cut), "every lecture volume is counted cut off"
+    np.testing.assert_array_equal(image, to_infinity)
+
+
+@pytest.mark.gl
+def test_bounded_volumes_only_for_zfail_and_fine_depth_steps(gl_ctx):
+    scene = load_preset("lecture")
+    renderer = Renderer(gl_ctx)
+    try:
+        _frame(gl_ctx, scene, renderer)
+        shadows, view = renderer.shadow_volumes, renderer._view
+        assert shadows.bounded_for(view, "zfail")
+        assert not shadows.bounded_for(view, "zpass")     # z-pass keeps its failure
+        coarse = dataclasses.replace(view, near=1e-7)      # depth steps of metres out there
+        assert not shadows.bounded_for(coarse, "zfail")
+        assert not shadows.bounded_for(dataclasses.replace(view, near=0.0), "zfail")
+    finally:
+        renderer.release()

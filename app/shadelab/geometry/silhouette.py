@@ -611,3 +611,69 @@ def _convex_hull_2d(points: np.ndarray) -> np.ndarray:
             upper.pop()
         upper.append(p)
     return np.array(lower[:-1] + upper[:-1])
+
+
+# A bounded volume's far points lie on a face of the receivers' box grown by this share of its
+# diagonal (beyond every receiver by far more than a depth step; see bounded_volume)
+BOUND_MARGIN = 0.02
+BOUND_MIN_COSINE = 1e-3   # a ray must leave through the chosen face at least this steeply
+
+
+def volume_sources(n: int, count_volume_rows: bool = False) -> np.ndarray:
+    """For each row of a silhouette or per-triangle volume's vertices (``n`` near points,
+    then their ``n`` points at infinity; with ``count_volume_rows``, then a
+    :class:`CountVolume`'s near apex and far apex): the row of the near point its ray
+    starts from (a near row: itself)."""
+    rows = [np.arange(n), np.arange(n)]
+    if count_volume_rows:
+        rows.append(np.array([2 * n, 2 * n]))
+    return np.concatenate(rows).astype(np.int64)
+
+
+def bounded_volume(vertices: np.ndarray, sources: np.ndarray, box: np.ndarray,
+                   margin: float) -> tuple[np.ndarray, int, float] | None:
+    """The volume with its points at infinity brought in to a face of the receivers' ``box``
+    (2, 3) grown by ``margin``: each ray from its near point (``sources``, see
+    :func:`volume_sources`) stops where it leaves through that face. Returns (vertices (M, 4),
+    all w = 1; the face as axis * 2 + side; the farthest a ray runs), or None where no face
+    is crossed by every ray at least BOUND_MIN_COSINE steeply, or a near point lies outside.
+
+    For every point of the box, the count (the winding number of the closed surface) is the
+    same: what is cut off, the rays' ends beyond the face and the cap at infinity closed by
+    the new cap on the face, is a closed surface all on the far side of the face, and winds
+    0 times around anything on the near side. The caps keep their topology, being the
+    central projection onto the face of the directions, all in the open hemisphere the face
+    looks into. The sides then end past the last receiver instead of running on across the
+    screen (far less stencil fill, issue 25); z-fail counts the same because its rays from a
+    visible point run to the far cap wherever it is, and no clip plane cuts a finite volume
+    with depth clamp on."""
+    v = np.asarray(vertices, dtype=np.float64)
+    far = v[:, 3] == 0.0
+    if not far.any():
+        return None
+    starts = v[sources[far], :3]
+    directions = v[far, :3] / np.maximum(np.linalg.norm(v[far, :3], axis=1, keepdims=True),
+                                         1e-300)
+    near = v[~far, :3]
+    grown = np.stack([box[0] - margin, box[1] + margin])
+    best = None
+    for axis in range(3):
+        for side, sign in ((0, -1.0), (1, 1.0)):
+            level = sign * grown[side, axis]            # plane: sign * x[axis] = level
+            slope = sign * directions[:, axis]
+            if slope.min() < BOUND_MIN_COSINE:
+                continue
+            if (sign * near[:, axis]).max(initial=-np.inf) >= level - 0.5 * margin:
+                continue
+            t = (level - sign * starts[:, axis]) / slope
+            reach = float(t.max())
+            if best is None or reach < best[0]:
+                best = (reach, axis, side, t)
+    if best is None:
+        return None
+    reach, axis, side, t = best
+    out = v.copy()
+    out[far, :3] = starts + t[:, None] * directions
+    out[far, 3] = 1.0
+    out[far, axis] = grown[side, axis]      # exactly on the face
+    return out, 2 * axis + side, reach

@@ -119,6 +119,7 @@ class View:
     # how far from the eye the near plane reaches (:func:`near_reach`); inf: unknown, and
     # nothing is taken to be seen from outside
     near_reach: float = math.inf
+    near: float = 0.0  # the near plane's distance (0: unknown; the depth steps follow from it)
 
 
 class ProgramUniforms:
@@ -150,7 +151,7 @@ def make_view(scene: Scene, size: tuple[int, int], meshes: list[MeshData],
     far = math.inf if infinite_far else far_plane(scene.camera, bounds)
     eye = np.asarray(scene.camera.eye, dtype=np.float64)
     return View(clip_from_world(scene.camera, aspect, far), eye, size,
-                near_reach(scene, size))
+                near_reach(scene, size), float(scene.camera.near))
 
 
 class Renderer:
