@@ -5,6 +5,7 @@ of its own mesh, fans only where the stencil counts are the same."""
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 
 import numpy as np
@@ -453,6 +454,26 @@ def test_bounded_volume_refuses_rays_no_face_of_the_box_catches():
 
 
 # ------------------------------------------------------------------ bounded volumes (GL)
+@contextlib.contextmanager
+def _renderer(ctx):
+    renderer = Renderer(ctx)
+    try:
+        yield renderer
+    finally:
+        renderer.release()
+
+
+def _switched(ctx, monkeypatch, module, switch: str, scene, probe):
+    """(image with ``module.switch`` False, image with it True, ``probe(renderer)`` of the
+    second frame's renderer)."""
+    monkeypatch.setattr(module, switch, False)
+    off, _ = _frame(ctx, scene)
+    monkeypatch.setattr(module, switch, True)
+    with _renderer(ctx) as renderer:
+        on, _ = _frame(ctx, scene, renderer)
+        return off, on, probe(renderer)
+
+
 @pytest.mark.gl
 @pytest.mark.parametrize("preset, overrides", [
     ("lecture", []), ("lecture", ["camera.eye=[1.465, -1.0, -0.907]"]),
@@ -466,17 +487,14 @@ def test_bounded_volumes_keep_the_image(gl_ctx, monkeypatch, preset, overrides):
     volumes to infinity give, bit for bit, and on the lecture it is the cut geometry that
     was counted."""
     scene = load_preset(preset, overrides)
-    monkeypatch.setattr(shadows_module, "BOUNDED_VOLUMES", False)
-    to_infinity, _ = _frame(gl_ctx, scene)
-    monkeypatch.setattr(shadows_module, "BOUNDED_VOLUMES", True)
-    renderer = Renderer(gl_ctx)
-    try:
-        image, _ = _frame(gl_ctx, scene, renderer)
+
+    def cut_geometry(renderer):
         shadows = renderer.shadow_volumes
-        used = shadows.bounded_for(renderer._view, scene.render.shadow_method)
-        cut = [v.bounded_vao is not None for v in shadows._cache.values()]
-    finally:
-        renderer.release()
+        return (shadows.bounded_for(renderer._view, scene.render.shadow_method),
+                [v.bounded_vao is not None for v in shadows._cache.values()])
+
+    to_infinity, image, (used, cut) = _switched(gl_ctx, monkeypatch, shadows_module,
+                                                "BOUNDED_VOLUMES", scene, cut_geometry)
     if preset == "lecture" and not overrides:
         assert used and all(cut), "every lecture volume is counted cut off"
     np.testing.assert_array_equal(image, to_infinity)
@@ -496,3 +514,74 @@ def test_bounded_volumes_only_for_zfail_and_fine_depth_steps(gl_ctx):
         assert not shadows.bounded_for(dataclasses.replace(view, near=0.0), "zfail")
     finally:
         renderer.release()
+
+
+# ------------------------------------------------------------------ one light, lit first
+@pytest.mark.gl
+@pytest.mark.parametrize("preset, overrides", [
+    ("lecture", []), ("lecture", ["render.shading=flat"]), ("lecture", ["render.specular=blinn"]),
+    ("lecture", ["render.shadow_method=zpass"]), ("lecture", ["render.shading=gouraud"]),
+    ("lecture", [f"camera.eye={PLASTIC_CENTRE}", "camera.target=[0.0, 0.7, -3.0]"]),
+    ("cornell", ["render.shadows=volumes"]), ("shadows", []), ("mesh-open", []),
+    ("mesh-spot", []), ("mesh-stl", []), ("fail-open-caster", []),
+    ("fail-zpass-eye-inside", []),
+    ("surface-detail", ["render.shadows=volumes", "lights.1.enabled=false"]),
+])
+def test_lit_first_keeps_the_image(gl_ctx, monkeypatch, preset, overrides):
+    """One light: ambient + light first, the count, ambient over the shadow gives the image
+    of the ambient pass, the count and the additive lit pass: bit for bit where the colour is
+    shaded per pixel (ambient + x = x + ambient); Gouraud interpolates the sum instead of
+    adding two interpolations, equal to float rounding."""
+    scene = load_preset(preset, overrides)
+    two_passes, image, lit_first = _switched(
+        gl_ctx, monkeypatch, renderer_module, "LIT_FIRST", scene,
+        lambda renderer: renderer._lit_first(scene, scene.active_lights()))
+    assert lit_first
+    assert (np.abs(two_passes - np.asarray(scene.render.background)).max(axis=-1) > 0).any()
+    if scene.render.shading == "gouraud":
+        np.testing.assert_allclose(image, two_passes, rtol=0.0, atol=2e-5)
+    else:
+        np.testing.assert_array_equal(image, two_passes)
+
+
+@pytest.mark.gl
+def test_lit_first_only_for_one_light_and_opaque_casters(gl_ctx):
+    with _renderer(gl_ctx) as renderer:
+        lecture = load_preset("lecture")
+        assert renderer._lit_first(lecture, lecture.active_lights())
+        several = load_preset("shadows-colored")
+        assert len(several.active_lights()) > 1
+        assert not renderer._lit_first(several, several.active_lights())
+        glass = load_preset("lecture", ["materials.plastic.kt=0.5"])
+        assert not renderer._lit_first(glass, glass.active_lights())
+
+
+@pytest.mark.gl
+def test_near_first_draws_what_lies_in_front_first(gl_ctx):
+    scene = load_preset("lecture")
+    with _renderer(gl_ctx) as renderer:
+        _frame(gl_ctx, scene, renderer)
+        meshes = [renderer._gpu[k] for k in range(len(scene.objects))]
+        order = [scene.objects[g.mesh.index].name
+                 for g in renderer_module._near_first(meshes, np.asarray(scene.camera.eye))]
+    assert order.index("back wall") < order.index("floor")       # the floor reaches behind it
+    assert max(order.index(n) for n in ("matte sphere", "plastic sphere", "metal sphere",
+                                         "box")) < order.index("back wall")
+
+
+@pytest.mark.gl
+def test_the_lit_pass_variant_fades_on_a_context_with_no_program_yet(gl_ctx):
+    """A frame that starts with the lit pass (one light, lit first) compiles the terminator
+    variant before any other program: it must still see ShadeLab's lighting chunk and fade
+    (it compiled without TERMINATOR, a bright rim on the dark side of the first frame)."""
+    scene = load_preset("lecture")
+    saved = dict(gl_ctx.includes)
+    gl_ctx.includes.clear()
+    try:
+        with _renderer(gl_ctx) as renderer:
+            variant = renderer.programs_for_lights(scene.active_lights(), "phong",
+                                                   terminator=True)
+        assert variant.defines.get("TERMINATOR") == 1
+    finally:
+        gl_ctx.includes.clear()
+        gl_ctx.includes.update(saved)

@@ -57,6 +57,14 @@ DIFFUSE_SUFFIX = ":diffuse"
 # Opaque closed meshes seen from outside are drawn with their back faces culled
 # (Renderer.cullable); False draws every face (for A/B measurements and tests)
 BACK_FACE_CULLING = True
+# One light with shadow volumes (and no transparent caster): the first pass draws ambient plus
+# that light everywhere, depth written; after the stencil count the ambient-only programs
+# write over the pixels whose count is not 0 (Renderer._lit_first_passes). No ambient-only
+# pass over the whole frame and no blending: the image is the same bit for bit (ambient + x
+# is x + ambient). False: the ambient pass, the count, then the light added where the count
+# is 0, as for several lights (for A/B measurements and tests)
+LIT_FIRST = True
+NEAR_FIRST = True
 
 
 class ProgramVariant(dict):
@@ -432,28 +440,34 @@ class Renderer:
                 self.set_frame_uniforms(variant, scene, view, specular)
             draw_painter(self, scene, gpu_meshes, shading, view)
             return view
-        # --- PASS 2: opaque surfaces, ambient + every light in one pass (S_i = 1);
-        #     with shadow volumes: ambient + emission only (the lights come in pass 3)
-        self.ctx.enable_only(moderngl.DEPTH_TEST)
-        if shadowed:
-            self.use_lights([], specular)  # programs with no light loop: ambient + Le only
-        for variant in self.variants(shading):
-            self.set_frame_uniforms(variant, scene, view, specular)
-        self.draw_objects(scene, opaque, shading)
-        if shadowed:
-            self.use_lights(lights, specular)
+        if shadowed and self._lit_first(scene, lights):
+            # --- PASSES 2-3, one light: ambient + the light everywhere, its stencil count,
+            #     then ambient alone written over where the count is not 0
+            self._lit_first_passes(scene, target, view, gpu_meshes, opaque, lights[0],
+                                   shading, specular)
+        else:
+            # --- PASS 2: opaque surfaces, ambient + every light in one pass (S_i = 1);
+            #     with shadow volumes: ambient + emission only (the lights come in pass 3)
+            self.ctx.enable_only(moderngl.DEPTH_TEST)
+            if shadowed:
+                self.use_lights([], specular)  # programs with no light loop: ambient + Le
             for variant in self.variants(shading):
                 self.set_frame_uniforms(variant, scene, view, specular)
-        # --- PASS 3: per light, a stencil count of its shadow volumes (z-fail or z-pass),
-        #     then that light alone added where the count is 0 (S_i = 1), nowhere else
-        if shadowed:
-            from shadelab.gl.lite import glFlush
+            self.draw_objects(scene, opaque, shading)
+            if shadowed:
+                self.use_lights(lights, specular)
+                for variant in self.variants(shading):
+                    self.set_frame_uniforms(variant, scene, view, specular)
+            # --- PASS 3: per light, a stencil count of its shadow volumes (z-fail or
+            #     z-pass), then that light alone added where the count is 0 (S_i = 1)
+            if shadowed:
+                from shadelab.gl.lite import glFlush
 
-            # llvmpipe rasterizes pass 2 on its threads while this thread bins the volumes
-            # and the lit passes (else all of them wait for the display pass's flush)
-            glFlush()
-            self._shadow_passes(scene, target, view, gpu_meshes, opaque, lights, shading,
-                                specular)
+                # llvmpipe rasterizes pass 2 on its threads while this thread bins the
+                # volumes and the lit passes (else all of them wait for the display pass)
+                glFlush()
+                self._shadow_passes(scene, target, view, gpu_meshes, opaque, lights,
+                                    shading, specular)
         # --- PASS 4: transparent surfaces back to front, blended by their model
         #     (interpolated or filtered), depth-tested against the opaque ones
         if clear:
@@ -475,6 +489,55 @@ class Renderer:
 
             self._shadows = ShadowVolumes(self.ctx)
         return self._shadows
+
+    def _lit_first(self, scene: Scene, lights: list[Light]) -> bool:
+        """Can the shadowed frame take :meth:`_lit_first_passes`? One light, and no
+        transparent object casting a shadow (its kt filter needs the flags' passes)."""
+        return LIT_FIRST and len(lights) == 1 and not any(
+            obj.cast_shadows and is_transparent(scene.materials[obj.material])
+            for obj in scene.objects)
+
+    def _lit_first_passes(self, scene: Scene, target: RenderTarget, view: View, gpu_meshes,
+                          opaque, light: Light, shading: str, specular: str) -> None:
+        """One light's shadowed frame in three passes: ambient + the light everywhere (the
+        lit pass's programs, terminator fade included, ambient on; depth written), the
+        light's stencil count, then the same programs with the light dark over the pixels
+        whose count is not 0 (S = 0 there). The sum ambient + light is the one the additive
+        pass makes, in the other order: the same floats."""
+        from shadelab.gl.lite import glFlush
+
+        self.ctx.enable_only(moderngl.DEPTH_TEST)
+        self.use_lights([light], specular, terminator=True)
+        for variant in self.variants(shading):
+            self.set_frame_uniforms(variant, scene, view, specular, [light], ambient_on=1.0)
+        self.draw_objects(scene, _near_first(opaque, view.eye) if NEAR_FIRST else opaque,
+                          shading, terminator=True)
+        for variant in self.variants(shading):   # this light's variant: fade off again
+            set_uniform(variant, "u_terminator", 0.0)
+        glFlush()   # llvmpipe rasterizes it while this thread bins the volumes
+        shadows = self.shadow_volumes
+        shadows.drop_lights_from(1)
+        volumes = shadows.volumes(scene, gpu_meshes, 0, light)
+        shadows.count(target, view, volumes, scene.render.shadow_method, clear=False)
+        self.ctx.enable_only(moderngl.DEPTH_TEST)
+        self.ctx.depth_func = "<="
+        shadows.where_not_zero()
+        # the same programs as pass 2 (the same positions, so the depth test "<=" passes on
+        # exactly the pixels pass 2 drew), the light dark: S Ip kd Od = S Ip ks Os = 0, so
+        # each writes Le + Ia ka Od + 0, what the ambient-only programs write
+        dark = replace(light, Ip=(0.0, 0.0, 0.0))
+        for variant in self.variants(shading):
+            self.set_frame_uniforms(variant, scene, view, specular, [dark], ambient_on=1.0)
+        self.draw_objects(scene, opaque, shading, terminator=True)
+        for variant in self.variants(shading):
+            set_uniform(variant, "u_terminator", 0.0)
+        shadows.stencil_off()
+        self.use_lights([light], specular)
+        self.ctx.depth_func = "<"
+        target.fbo.depth_mask = True
+        target.fbo.use()
+        for variant in self.variants(shading):
+            self.set_frame_lights(variant, [light], ambient_on=1.0)
 
     def _shadow_passes(self, scene: Scene, target: RenderTarget, view: View, gpu_meshes,
                        opaque, lights: list[Light], shading: str, specular: str) -> None:
@@ -672,8 +735,26 @@ class Renderer:
 def _chunk_fades(ctx: moderngl.Context) -> bool:
     """Whether the context's lighting chunk has the terminator fade (declares the
     ``terminator_t`` that the programs' TERMINATOR code sets): ShadeLab's own does; a student's
-    copy with the TERMINATOR blocks deleted does not, and compiles without them."""
+    copy with the TERMINATOR blocks deleted does not, and compiles without them. On a context
+    where no program was compiled yet the includes are registered first (else the first
+    program of a frame that starts with the lit pass compiled without the fade)."""
+    if "lighting" not in ctx.includes:
+        gl_programs.register_includes(ctx)
     return "float terminator_t" in ctx.includes.get("lighting", "")
+
+
+def _near_first(gpu_meshes: list[GpuMesh], eye: np.ndarray) -> list[GpuMesh]:
+    """The meshes by the distance from ``eye`` to the farthest corner of their box, nearest
+    first: what lies in front mostly draws first, and llvmpipe's early depth test then skips
+    shading what it hides (a floor reaching behind a wall)."""
+    def reach(gpu: GpuMesh) -> float:
+        corners = gpu.bounds[_CORNER_PICK, [0, 1, 2]]
+        return float(np.linalg.norm(corners - eye, axis=1).max())
+
+    return sorted(gpu_meshes, key=reach)
+
+
+_CORNER_PICK = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)])
 
 
 def _material_runs(gpu_meshes: list[GpuMesh]) -> list[list[GpuMesh]]:

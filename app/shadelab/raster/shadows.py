@@ -424,6 +424,16 @@ class ShadowVolumes:
         target.fbo.color_mask = (True, True, True, True)
         target.fbo.use()  # color writes back on; depth writes stay off until the frame ends
 
+    def where_not_zero(self) -> None:
+        """Stencil state for the ambient-only pass of one light's shadowed frame
+        (Renderer._lit_first_passes): draw only where the count is not 0 (in shadow)."""
+        GL = _gl()
+        _ = self.ctx.error
+        GL.glEnable(GL.GL_STENCIL_TEST)
+        GL.glStencilMask(0x00)
+        GL.glStencilFunc(GL.GL_NOTEQUAL, 0, 0xFF)
+        GL.glStencilOp(GL.GL_KEEP, GL.GL_KEEP, GL.GL_KEEP)
+
     def lit_where_zero(self, ref: int = 0) -> None:
         """Stencil state for the additive lit pass: draw only where the stencil is ``ref``
         (the volume count 0, and with transparent casters exactly their flags ``ref``)."""
