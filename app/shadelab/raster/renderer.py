@@ -735,11 +735,10 @@ class Renderer:
 def _chunk_fades(ctx: moderngl.Context) -> bool:
     """Whether the context's lighting chunk has the terminator fade (declares the
     ``terminator_t`` that the programs' TERMINATOR code sets): ShadeLab's own does; a student's
-    copy with the TERMINATOR blocks deleted does not, and compiles without them. On a context
-    where no program was compiled yet the includes are registered first (else the first
-    program of a frame that starts with the lit pass compiled without the fade)."""
-    if "lighting" not in ctx.includes:
-        gl_programs.register_includes(ctx)
+    copy with the TERMINATOR blocks deleted does not, and compiles without them. The includes
+    are registered first, as the compile will (else a frame that starts with the lit pass saw
+    none yet, or a previous render's: a fade missing, or asked of a chunk without one)."""
+    gl_programs.register_includes(ctx)
     return "float terminator_t" in ctx.includes.get("lighting", "")
 
 
