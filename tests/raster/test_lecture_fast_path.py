@@ -503,8 +503,7 @@ def test_bounded_volumes_keep_the_image(gl_ctx, monkeypatch, preset, overrides):
 @pytest.mark.gl
 def test_bounded_volumes_only_for_zfail_and_fine_depth_steps(gl_ctx):
     scene = load_preset("lecture")
-    renderer = Renderer(gl_ctx)
-    try:
+    with _renderer(gl_ctx) as renderer:
         _frame(gl_ctx, scene, renderer)
         shadows, view = renderer.shadow_volumes, renderer._view
         assert shadows.bounded_for(view, "zfail")
@@ -512,8 +511,6 @@ def test_bounded_volumes_only_for_zfail_and_fine_depth_steps(gl_ctx):
         coarse = dataclasses.replace(view, near=1e-7)      # depth steps of metres out there
         assert not shadows.bounded_for(coarse, "zfail")
         assert not shadows.bounded_for(dataclasses.replace(view, near=0.0), "zfail")
-    finally:
-        renderer.release()
 
 
 # ------------------------------------------------------------------ one light, lit first

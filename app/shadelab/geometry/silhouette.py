@@ -383,6 +383,11 @@ def shadows_nothing(vertices: np.ndarray, face_normals: np.ndarray, light: np.nd
 _CORNER_PICK = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)])
 
 
+def box_corners(box: np.ndarray) -> np.ndarray:
+    """The 8 corners (8, 3) of a (2, 3) min/max box."""
+    return np.asarray(box, dtype=np.float64)[_CORNER_PICK, [0, 1, 2]]
+
+
 @dataclass
 class CountVolume:
     """A silhouette volume with cheaper caps, for the stencil count only (the same counts as
@@ -577,7 +582,7 @@ def planar_occluder(vertices: np.ndarray, faces: np.ndarray, face_normals: np.nd
 def _box_behind(box: np.ndarray, normal: np.ndarray, level: float) -> np.ndarray:
     """Corners of the (2, 3) box clipped to ``normal . x <= level``: the box's corners there
     and where its edges cross the plane (the clipped box is their convex hull)."""
-    corners = np.asarray(box, dtype=np.float64)[_CORNER_PICK, [0, 1, 2]]      # (8, 3)
+    corners = box_corners(box)                                                # (8, 3)
     height = corners @ normal - level
     keep = [corners[height <= 0.0]]
     for i in range(8):

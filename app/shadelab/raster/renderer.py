@@ -14,6 +14,7 @@ import moderngl
 import numpy as np
 
 from shadelab.geometry.mesh import MeshData, geometry_key, object_mesh, scene_bounds
+from shadelab.geometry.silhouette import box_corners
 from shadelab.gl import programs as gl_programs
 from shadelab.gl.programs import (
     UniformCache,
@@ -58,12 +59,14 @@ DIFFUSE_SUFFIX = ":diffuse"
 # (Renderer.cullable); False draws every face (for A/B measurements and tests)
 BACK_FACE_CULLING = True
 # One light with shadow volumes (and no transparent caster): the first pass draws ambient plus
-# that light everywhere, depth written; after the stencil count the ambient-only programs
-# write over the pixels whose count is not 0 (Renderer._lit_first_passes). No ambient-only
-# pass over the whole frame and no blending: the image is the same bit for bit (ambient + x
-# is x + ambient). False: the ambient pass, the count, then the light added where the count
-# is 0, as for several lights (for A/B measurements and tests)
+# that light everywhere, depth written; after the stencil count the same programs with the
+# light dark write over the pixels whose count is not 0 (Renderer._lit_first_passes). No
+# ambient-only pass over the whole frame and no blending: the image is the same bit for bit
+# (ambient + x is x + ambient). False: the ambient pass, the count, then the light added where
+# the count is 0, as for several lights (for A/B measurements and tests)
 LIT_FIRST = True
+# ... and that first pass draws the meshes nearest first (_near_first), so llvmpipe's early
+# depth test skips shading what they hide; False: scene order (A/B measurements, tests)
 NEAR_FIRST = True
 
 
@@ -747,13 +750,9 @@ def _near_first(gpu_meshes: list[GpuMesh], eye: np.ndarray) -> list[GpuMesh]:
     first: what lies in front mostly draws first, and llvmpipe's early depth test then skips
     shading what it hides (a floor reaching behind a wall)."""
     def reach(gpu: GpuMesh) -> float:
-        corners = gpu.bounds[_CORNER_PICK, [0, 1, 2]]
-        return float(np.linalg.norm(corners - eye, axis=1).max())
+        return float(np.linalg.norm(box_corners(gpu.bounds) - eye, axis=1).max())
 
     return sorted(gpu_meshes, key=reach)
-
-
-_CORNER_PICK = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)])
 
 
 def _material_runs(gpu_meshes: list[GpuMesh]) -> list[list[GpuMesh]]:

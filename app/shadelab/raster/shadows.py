@@ -39,6 +39,7 @@ from shadelab.geometry.silhouette import (
     PlanarOccluder,
     ShadowVolume,
     bounded_volume,
+    box_corners,
     closed_caster,
     count_volume,
     is_convex,
@@ -83,9 +84,6 @@ BOUNDED_VOLUMES = True
 # them only while a depth step there is below 1/DEPTH_STEPS_IN_MARGIN of that (a 24-bit depth
 # buffer, infinite far plane: a step at distance z is z^2 / (near 2^24))
 DEPTH_STEPS_IN_MARGIN = 64
-
-
-_CORNERS = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)])
 
 
 def filter_bit(slot: int) -> int:
@@ -284,7 +282,7 @@ class ShadowVolumes:
         if not BOUNDED_VOLUMES or method != "zfail" or not near > 0.0:
             return False
         margin = self.margin()
-        corners = self._box[_CORNERS, [0, 1, 2]]
+        corners = box_corners(self._box)
         farthest = float(np.linalg.norm(corners - view.eye, axis=1).max()) + 2.0 * margin
         step = farthest * farthest / (near * float(1 << 24))
         return step * DEPTH_STEPS_IN_MARGIN < margin
