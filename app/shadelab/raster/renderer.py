@@ -59,10 +59,10 @@ DIFFUSE_SUFFIX = ":diffuse"
 # (Renderer.cullable); False draws every face (for A/B measurements and tests)
 BACK_FACE_CULLING = True
 # One light with shadow volumes (and no transparent caster): the first pass draws ambient plus
-# that light everywhere, depth written; after the stencil count the same programs with the
-# light dark write over the pixels whose count is not 0 (Renderer._lit_first_passes). No
-# ambient-only pass over the whole frame and no blending: the image is the same bit for bit
-# (ambient + x is x + ambient). False: the ambient pass, the count, then the light added where
+# that light everywhere, depth written; after the stencil count the ambient-only programs write
+# over the pixels whose count is not 0 (Renderer._lit_first_passes). No ambient pass over the
+# whole frame and no blending: the image is the same bit for bit (ambient + x is x + ambient;
+# Gouraud within float rounding). False: the ambient pass, the count, then the light added where
 # the count is 0, as for several lights (for A/B measurements and tests)
 LIT_FIRST = True
 # ... and that first pass draws the meshes nearest first (_near_first), so llvmpipe's early
@@ -504,9 +504,10 @@ class Renderer:
                           opaque, light: Light, shading: str, specular: str) -> None:
         """One light's shadowed frame in three passes: ambient + the light everywhere (the
         lit pass's programs, terminator fade included, ambient on; depth written), the
-        light's stencil count, then the same programs with the light dark over the pixels
-        whose count is not 0 (S = 0 there). The sum ambient + light is the one the additive
-        pass makes, in the other order: the same floats."""
+        light's stencil count, then the ambient-only programs over the pixels whose count is
+        not 0 (S = 0 there: ambient + 0). The sum ambient + light is the one the additive
+        pass makes, in the other order: the same floats (Gouraud: within float rounding, its
+        colors interpolated as one sum)."""
         from shadelab.gl.lite import glFlush
 
         self.ctx.enable_only(moderngl.DEPTH_TEST)
@@ -525,15 +526,14 @@ class Renderer:
         self.ctx.enable_only(moderngl.DEPTH_TEST)
         self.ctx.depth_func = "<="
         shadows.where_not_zero()
-        # the same programs as pass 2 (the same positions, so the depth test "<=" passes on
-        # exactly the pixels pass 2 drew), the light dark: S Ip kd Od = S Ip ks Os = 0, so
-        # each writes Le + Ia ka Od + 0, what the ambient-only programs write
-        dark = replace(light, Ip=(0.0, 0.0, 0.0))
+        # the ambient-only programs (no light loop: Le + Ia ka Od, u_ambient premultiplied),
+        # what the lit programs write where S = 0; their vertex shader is the lit pass's
+        # (invariant gl_Position), so "<=" passes exactly where pass 2 drew. Only the pixels in
+        # shadow run them, without the varyings and the light's math the lit programs carry
+        self.use_lights([], specular)
         for variant in self.variants(shading):
-            self.set_frame_uniforms(variant, scene, view, specular, [dark], ambient_on=1.0)
-        self.draw_objects(scene, opaque, shading, terminator=True)
-        for variant in self.variants(shading):
-            set_uniform(variant, "u_terminator", 0.0)
+            self.set_frame_uniforms(variant, scene, view, specular, [], ambient_on=1.0)
+        self.draw_objects(scene, opaque, shading)
         shadows.stencil_off()
         self.use_lights([light], specular)
         self.ctx.depth_func = "<"
