@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import pytest
 
@@ -99,6 +100,14 @@ def test_goals_name_a_skipped_section_and_a_failed_peer_run():
         "viewer.cases.lecture_1280x720.fps_over_polyscope missing from the report"
 
 
+def _viewer_report(path: str) -> None:
+    """What a viewer run's --bench-json holds (a stand-in: 20 ms redraws, 5 ms idle frames)."""
+    with open(path, "w") as f:
+        json.dump({"frames": 9, "triangles": 38, "first_frame_s": 0.8,
+                   "redraw_frame_ms_median": 20.0, "idle_frame_ms_median": 5.0,
+                   "redraw_cpu_ms_median": 18.0, "idle_cpu_ms_median": 4.0}, f)
+
+
 def test_viewer_bench_without_polyscope_names_the_install_command(monkeypatch):
     """Polyscope absent (simulated): no peer command runs, every case says how to install it,
     and the goals count the comparison as not measured, with that command."""
@@ -119,11 +128,7 @@ def test_viewer_bench_without_polyscope_names_the_install_command(monkeypatch):
         assert "polyscope" not in script
         for part in script.split(" ; "):
             words = part.split()
-            out = words[words.index("--bench-json") + 1]
-            with open(out, "w") as f:
-                json.dump({"frames": 9, "triangles": 38, "first_frame_s": 0.8,
-                           "redraw_frame_ms_median": 20.0, "idle_frame_ms_median": 5.0,
-                           "redraw_cpu_ms_median": 18.0, "idle_cpu_ms_median": 4.0}, f)
+            _viewer_report(words[words.index("--bench-json") + 1])
         return subprocess.CompletedProcess(command, 0, "", "")
 
     monkeypatch.setattr(viewer.subprocess, "run", fake_run)
@@ -144,6 +149,54 @@ def test_viewer_bench_without_polyscope_names_the_install_command(monkeypatch):
         assert why[name] == f"polyscope not installed ({goals.INSTALL_PEERS})"
     assert {row["goal"] for row in verdict["checked"]} == \
         {"viewer's first frame within 1.0 s of process start"}
+
+
+def test_viewer_bench_reports_each_case_s_median_round(monkeypatch):
+    """The full bench runs every case's pair once per round, in turn; a case reports the round
+    whose ratio to Polyscope is the median (all its figures from that pair) and lists every
+    round's ratio in the order they ran."""
+    import subprocess
+
+    from shadelab.bench import viewer
+
+    monkeypatch.setattr(viewer, "polyscope_command",
+                        lambda frames, out, *a, **k: ["polyscope-stand-in", out])
+    runs_per_case: dict[str, int] = {}
+    order = []
+
+    def fake_run(command, **kwargs):
+        for part in command[-1].split(" ; "):
+            words = part.split()
+            if words[0] == "polyscope-stand-in":
+                name = Path(words[1]).name.split("-")[0]
+                if name not in runs_per_case:
+                    continue                      # the unmeasured warm-up
+                turn = runs_per_case[name] - 1
+                with open(words[1], "w") as f:
+                    json.dump({"frame_ms_median": (30.0, 22.0, 26.0)[turn],
+                               "cpu_ms_median": 40.0}, f)
+                continue
+            out = words[words.index("--bench-json") + 1]
+            name = Path(out).name.split("-")[0]
+            runs_per_case[name] = runs_per_case.get(name, 0) + 1
+            order.append(name)
+            _viewer_report(out)
+        return subprocess.CompletedProcess(command, 0, "", "")
+
+    monkeypatch.setattr(viewer.subprocess, "run", fake_run)
+    monkeypatch.setenv("DISPLAY", ":99")
+    section = viewer.run(quick=False)
+    names = [viewer.case_name(*c) for c in viewer.CASES]
+    assert section["rounds"] == viewer.ROUNDS == 3
+    # warm-up first, then the cases in turn, round after round (the 80k mesh in the first)
+    assert order[1:] == names + ["mesh80k_1280x720"] + names * 2
+    for name in names:
+        case = section["cases"][name]
+        assert [r["fps_over_polyscope"] for r in case["rounds"]] == \
+            pytest.approx([1.5, 1.1, 1.3])
+        assert case["round"] == 2 and case["fps_over_polyscope"] == pytest.approx(1.3)
+        assert case["polyscope"]["frame_ms_median"] == 26.0
+    assert section["fps_over_polyscope_min"] == pytest.approx(1.3)
 
 
 def test_viewer_bench_without_a_display_says_so(monkeypatch):
