@@ -541,6 +541,79 @@ def test_lit_first_keeps_the_image(gl_ctx, monkeypatch, preset, overrides):
         np.testing.assert_array_equal(image, two_passes)
 
 
+SCISSOR_VIEWS = [
+    ("lecture", []), ("lecture", ["camera.eye=[1.465, -1.0, -0.907]"]),
+    ("lecture", [f"camera.eye={PLASTIC_CENTRE}", "camera.target=[0.0, 0.7, -3.0]"]),
+    ("lecture", ["camera.eye=[0.0, 40.0, 60.0]"]), ("lecture", ["render.shadow_method=zpass"]),
+    ("lecture", ["lights.0.position=[-4.0, 2.0, 1.0]"]), ("lecture", ["render.shading=gouraud"]),
+    ("shadows", []), ("mesh-open", []), ("mesh-spot", []), ("mesh-stl", []),
+    ("fail-open-caster", []), ("cornell-spheres", ["render.shadows=volumes"]),
+    ("cornell", ["render.shadows=volumes"]),
+]
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("preset, overrides", SCISSOR_VIEWS)
+def test_the_shadow_rectangle_holds_every_counted_pixel(gl_ctx, preset, overrides):
+    """ShadowVolumes.screen_rect: every pixel whose count is not 0 lies in it (the stencil
+    after the frame is the count); on the lecture it leaves most of the frame out; None only
+    where a counted point lies behind the eye (cornell's blocks, counted to infinity; the eye
+    under the floor or inside a sphere, where no shadow is in view)."""
+    scene = load_preset(preset, overrides)
+    assert len(scene.active_lights()) == 1
+    with _renderer(gl_ctx) as renderer:
+        _, stencil = _frame(gl_ctx, scene, renderer)
+        shadows = renderer.shadow_volumes
+        volumes = shadows.volumes(scene, renderer.sync(scene), 0, scene.active_lights()[0])
+        view = renderer._view
+        rect = shadows.screen_rect(view, volumes, scene.render.shadow_method)
+        bounded = shadows.bounded_for(view, scene.render.shadow_method)
+        points = np.vstack([v.count_points(bounded) for v in volumes if not v.hidden_from(view)])
+    rows, cols = np.nonzero(stencil)
+    shadowless = {"camera.eye=[1.465, -1.0, -0.907]", f"camera.eye={PLASTIC_CENTRE}"}
+    if not shadowless & set(overrides):
+        assert len(rows) > 0, "the view shows some shadow"
+    if rect is None:    # only where a counted point lies at or behind the eye's plane
+        assert (points @ view.clip_from_world.T)[:, 3].min() <= 0.0
+        assert preset != "lecture" or shadowless & set(overrides)
+        return
+    x, y, width, height = rect
+    up = SIZE[1] - 1 - rows                       # stencil rows run from the top
+    if len(rows) == 0:
+        return
+    assert cols.min() >= x and cols.max() < x + width
+    assert up.min() >= y and up.max() < y + height
+    if preset == "lecture" and not overrides:
+        assert width * height < 0.5 * SIZE[0] * SIZE[1]
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("preset, overrides", SCISSOR_VIEWS)
+def test_the_scissored_shadow_pass_keeps_the_image(gl_ctx, monkeypatch, preset, overrides):
+    """The ambient-only pass over the shadow drawn inside screen_rect only: the same image
+    bit for bit."""
+    scene = load_preset(preset, overrides)
+    whole, image, _ = _switched(gl_ctx, monkeypatch, renderer_module, "SCISSOR_SHADOW",
+                                scene, lambda renderer: None)
+    np.testing.assert_array_equal(image, whole)
+
+
+@pytest.mark.gl
+def test_a_rectangle_that_misses_the_shadow_changes_the_image(gl_ctx, monkeypatch):
+    """The scissor is applied: half the lecture's rectangle loses shadow pixels."""
+    scene = load_preset("lecture")
+    image, _ = _frame(gl_ctx, scene)
+    real = shadows_module.ShadowVolumes.screen_rect
+
+    def half(self, *args):
+        x, y, width, height = real(self, *args)
+        return x + width // 2, y, width - width // 2, height
+
+    monkeypatch.setattr(shadows_module.ShadowVolumes, "screen_rect", half)
+    cut, _ = _frame(gl_ctx, scene)
+    assert (np.abs(cut - image).max(axis=-1) > 0).sum() > 20
+
+
 @pytest.mark.gl
 def test_lit_first_only_for_one_light_and_opaque_casters(gl_ctx):
     with _renderer(gl_ctx) as renderer:

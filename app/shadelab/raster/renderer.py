@@ -68,6 +68,9 @@ LIT_FIRST = True
 # ... and that first pass draws the meshes nearest first (_near_first), so llvmpipe's early
 # depth test skips shading what they hide; False: scene order (A/B measurements, tests)
 NEAR_FIRST = True
+# ... and the ambient-only pass over the shadow is scissored to the rectangle the shadow volumes
+# cover on screen (ShadowVolumes.screen_rect); False: the whole frame (A/B runs, tests)
+SCISSOR_SHADOW = True
 
 
 class ProgramVariant(dict):
@@ -533,7 +536,14 @@ class Renderer:
         self.use_lights([], specular)
         for variant in self.variants(shading):
             self.set_frame_uniforms(variant, scene, view, specular, [], ambient_on=1.0)
-        self.draw_objects(scene, opaque, shading)
+        # ... within the rectangle that holds the volumes' pixels (no count elsewhere)
+        rect = shadows.screen_rect(view, volumes, scene.render.shadow_method) \
+            if SCISSOR_SHADOW else None
+        if rect is None or rect[2] * rect[3] > 0:
+            target.fbo.scissor = rect
+            target.fbo.use()
+            self.draw_objects(scene, opaque, shading)
+            target.fbo.scissor = None
         shadows.stencil_off()
         self.use_lights([light], specular)
         self.ctx.depth_func = "<"

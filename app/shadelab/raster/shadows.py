@@ -72,6 +72,8 @@ FILTER_SLOTS = 4  # transparent casters filtered per light; further ones cast no
 # The stencil count draws closed casters' volumes with fans for caps where the counts are the
 # same (silhouette.CountVolume); False counts with the full caps (A/B measurements, tests)
 REDUCED_CAPS = True
+# pixels added round ShadowVolumes.screen_rect (rasterization rules, float rounding)
+SCISSOR_PAD = 2
 # The count leaves out a flat opaque caster's volume where everything that volume could hold
 # is hidden behind that caster from the eye (silhouette.PlanarOccluder: the lecture's back
 # wall); False counts every volume (A/B measurements, tests)
@@ -129,6 +131,7 @@ class CasterVolume:
     bounded_key: tuple | None = None
     bounded_vbo: moderngl.Buffer | None = None
     bounded_vao: moderngl.VertexArray | None = None
+    bounded_points: np.ndarray | None = None  # (M, 4) the cut geometry's vertices, w = 1
 
     def hidden_from(self, view) -> bool:
         """Is nothing the volume could hold visible from the view's eye (its count 0 on
@@ -156,6 +159,16 @@ class CasterVolume:
         vao = self.bounded_vao if bounded else self.count_vao
         for first, faces in self.counted.ranges(_eye_outside(view, self.bounds)):
             vao.render(moderngl.TRIANGLES, vertices=3 * faces, first=3 * first)
+
+
+    def count_points(self, bounded: bool = False) -> np.ndarray:
+        """(N, 4) homogeneous world points whose convex hull holds every triangle
+        :meth:`render_count` draws with the same ``bounded``."""
+        bounded = bounded and self.bounded_vao is not None
+        if self.counted is None or not REDUCED_CAPS:
+            bounded = bounded and self.counted is None
+            return self.bounded_points if bounded else self.volume.vertices
+        return self.bounded_points if bounded else self.counted.vertices
 
 
 def _eye_outside(view, bounds: np.ndarray | None) -> bool:
@@ -267,6 +280,7 @@ class ShadowVolumes:
         n = len(caster.volume.vertices) // 2
         cut = bounded_volume(vertices, volume_sources(n, counted is not None), self._box,
                              self.margin())
+        caster.bounded_points = None if cut is None else cut[0]
         if cut is not None:
             faces = caster.volume.faces if counted is None else counted.faces
             caster.bounded_vbo = self.ctx.buffer(cut[0][faces].astype(np.float32).tobytes())
@@ -286,6 +300,31 @@ class ShadowVolumes:
         farthest = float(np.linalg.norm(corners - view.eye, axis=1).max()) + 2.0 * margin
         step = farthest * farthest / (near * float(1 << 24))
         return step * DEPTH_STEPS_IN_MARGIN < margin
+
+    def screen_rect(self, view, volumes: list[CasterVolume],
+                    method: str) -> tuple[int, int, int, int] | None:
+        """The window rectangle (x, y, width, height; pixels, from the bottom left) that
+        holds every pixel :meth:`count` can change, grown by SCISSOR_PAD pixels; None where
+        it cannot be bounded (a drawn point at or behind the eye's plane, clip w <= 0).
+
+        A triangle whose corners all lie in front of the eye projects to the triangle of
+        their projections, so the corners' projections bound every fragment the count
+        draws; the stencil outside stays at its cleared 0."""
+        bounded = self.bounded_for(view, method)
+        points = [c.count_points(bounded) for c in volumes if not c.hidden_from(view)]
+        if not points:
+            return 0, 0, 0, 0
+        clip = np.vstack(points) @ np.asarray(view.clip_from_world, dtype=np.float64).T
+        w = clip[:, 3]
+        if not w.min() > 1e-9 * np.abs(w).max():
+            return None
+        width, height = view.size
+        xs, ys = clip[:, 0] / w, clip[:, 1] / w
+        x0 = max(int(np.floor((xs.min() + 1.0) * 0.5 * width)) - SCISSOR_PAD, 0)
+        x1 = min(int(np.ceil((xs.max() + 1.0) * 0.5 * width)) + SCISSOR_PAD, width)
+        y0 = max(int(np.floor((ys.min() + 1.0) * 0.5 * height)) - SCISSOR_PAD, 0)
+        y1 = min(int(np.ceil((ys.max() + 1.0) * 0.5 * height)) + SCISSOR_PAD, height)
+        return x0, y0, max(x1 - x0, 0), max(y1 - y0, 0)
 
     def _occluder(self, members, gpu_meshes, light: Light, homogeneous: np.ndarray,
                   offset: float) -> PlanarOccluder | None:
