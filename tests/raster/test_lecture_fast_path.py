@@ -20,6 +20,7 @@ from shadelab.geometry.silhouette import (
     count_volume,
     is_convex,
     light_homogeneous,
+    open_volume,
     shadow_volume,
     volume_sources,
 )
@@ -432,6 +433,39 @@ def test_bounded_volume_counts_as_the_volume_to_infinity(caster, light, np_rng):
         np.testing.assert_array_equal(_counts(bounded, faces, homogeneous, points), before)
 
 
+def test_a_caster_on_the_floor_is_cut_off_past_its_moved_caps(np_rng):
+    """A box standing on the receivers' floor, counted as an open caster: the caps moved
+    along the rays (up to GRAZING_LIMIT offsets, where the light grazes its sides) reach
+    below the floor. The cut's plane moves out to half a margin past them (cornell's
+    blocks), and every point of the box keeps its count."""
+    margin = 0.02 * float(np.linalg.norm(np.ptp(BOX, axis=0)))
+    block = trimesh.creation.box(extents=(1.0, 1.6, 1.0))
+    block.apply_translation([0.4, BOX[0, 1] + 0.8, -0.3])       # its bottom on the floor
+    v, f = np.asarray(block.vertices, float), np.asarray(block.faces, np.int64)
+    homogeneous = light_homogeneous("point", (0.2, BOX[1, 1] - 0.5, 0.1), (0, 0, 0))
+    volume = open_volume([(v, f)], homogeneous, margin / 20.0)
+    near = volume.vertices[volume.vertices[:, 3] == 1.0]
+    below = BOX[0, 1] - near[:, 1]
+    assert below.max() > 0.5 * margin, "a moved cap reaches past half a margin"
+    n = len(volume.vertices) // 2
+    cut = bounded_volume(volume.vertices, volume_sources(n), BOX, margin)
+    assert cut is not None
+    bounded, face, _ = cut
+    assert face == 2 * 1 + 0                                    # the floor's face
+    far = volume.vertices[:, 3] == 0.0
+    plane = BOX[0, 1] - (below.max() + 0.5 * margin)
+    np.testing.assert_allclose(bounded[far, 1], plane)
+    assert BOX[0, 1] - 2.0 * margin <= plane < BOX[0, 1] - margin
+    points = np.concatenate([_points_in(BOX, np_rng, 1500),
+                             v[np_rng.integers(0, len(v), 500)] * [1.0, 0.0, 1.0]
+                             + [0.0, BOX[0, 1] + 1e-3, 0.0]
+                             + np_rng.normal(0.0, 0.6, (500, 3)) * [1.0, 0.0, 1.0]])
+    points = points[np.all((points > BOX[0]) & (points < BOX[1]), axis=1)]
+    before = _winding(points, _finite(volume.vertices, homogeneous, 1e6)[volume.faces])
+    assert (before != 0).sum() > 20, "some points of the floor lie in the shadow"
+    np.testing.assert_array_equal(_counts(bounded, volume.faces, homogeneous, points), before)
+
+
 def test_bounded_volume_refuses_rays_no_face_of_the_box_catches():
     """A light close to a wide plate facing the box's diagonal sends rays out through
     three faces, none crossed by all of them: no cut (counted to infinity); a plate
@@ -481,6 +515,7 @@ def _switched(ctx, monkeypatch, module, switch: str, scene, probe):
     ("lecture", ["camera.eye=[0.0, 40.0, 60.0]"]), ("shadows", []),
     ("shadows-colored", []), ("mesh-open", []), ("mesh-spot", []), ("mesh-stl", []),
     ("fail-open-caster", []), ("multi-lights", []), ("cornell-spheres", []),
+    ("cornell", ["render.shadows=volumes"]),
 ])
 def test_bounded_volumes_keep_the_image(gl_ctx, monkeypatch, preset, overrides):
     """The z-fail count with the volumes cut off at the receivers' box gives the image the
@@ -495,8 +530,8 @@ def test_bounded_volumes_keep_the_image(gl_ctx, monkeypatch, preset, overrides):
 
     to_infinity, image, (used, cut) = _switched(gl_ctx, monkeypatch, shadows_module,
                                                 "BOUNDED_VOLUMES", scene, cut_geometry)
-    if preset == "lecture" and not overrides:
-        assert used and all(cut), "every lecture volume is counted cut off"
+    if preset in ("lecture", "cornell") and len(overrides) == (preset == "cornell"):
+        assert used and all(cut), "every volume is counted cut off (cornell: its blocks too)"
     np.testing.assert_array_equal(image, to_infinity)
 
 
@@ -557,8 +592,8 @@ SCISSOR_VIEWS = [
 def test_the_shadow_rectangle_holds_every_counted_pixel(gl_ctx, preset, overrides):
     """ShadowVolumes.screen_rect: every pixel whose count is not 0 lies in it (the stencil
     after the frame is the count); on the lecture it leaves most of the frame out; None only
-    where a counted point lies behind the eye (cornell's blocks, counted to infinity; the eye
-    under the floor or inside a sphere, where no shadow is in view)."""
+    where a counted point lies at or behind the eye's plane (the eye under the floor or
+    inside a sphere, where no shadow is in view)."""
     scene = load_preset(preset, overrides)
     assert len(scene.active_lights()) == 1
     with _renderer(gl_ctx) as renderer:

@@ -639,9 +639,11 @@ def bounded_volume(vertices: np.ndarray, sources: np.ndarray, box: np.ndarray,
                    margin: float) -> tuple[np.ndarray, int, float] | None:
     """The volume with its points at infinity brought in to a face of the receivers' ``box``
     (2, 3) grown by ``margin``: each ray from its near point (``sources``, see
-    :func:`volume_sources`) stops where it leaves through that face. Returns (vertices (M, 4),
-    all w = 1; the face as axis * 2 + side; the farthest a ray runs), or None where no face
-    is crossed by every ray at least BOUND_MIN_COSINE steeply, or a near point lies outside.
+    :func:`volume_sources`) stops where it leaves through that face. Where a near point lies
+    within half a margin of the face (or past it), the plane moves out to half a margin past
+    the near points, at most one more margin. Returns (vertices (M, 4), all w = 1; the face as
+    axis * 2 + side; the farthest a ray runs), or None where no face is crossed by every ray
+    at least BOUND_MIN_COSINE steeply, or a near point lies farther out.
 
     For every point of the box, the count (the winding number of the closed surface) is the
     same: what is cut off, the rays' ends beyond the face and the cap at infinity closed by
@@ -668,17 +670,21 @@ def bounded_volume(vertices: np.ndarray, sources: np.ndarray, box: np.ndarray,
             slope = sign * directions[:, axis]
             if slope.min() < BOUND_MIN_COSINE:
                 continue
-            if (sign * near[:, axis]).max(initial=-np.inf) >= level - 0.5 * margin:
+            # a near point within half a margin of the face (a caster standing on the
+            # floor, its caps moved along the rays, GRAZING_LIMIT offsets at most): the
+            # plane moves out up to one more margin, still beyond every receiver
+            plane = max(level, (sign * near[:, axis]).max(initial=-np.inf) + 0.5 * margin)
+            if plane > level + margin:
                 continue
-            t = (level - sign * starts[:, axis]) / slope
+            t = (plane - sign * starts[:, axis]) / slope
             reach = float(t.max())
             if best is None or reach < best[0]:
-                best = (reach, axis, side, t)
+                best = (reach, axis, side, t, plane)
     if best is None:
         return None
-    reach, axis, side, t = best
+    reach, axis, side, t, plane = best
     out = v.copy()
     out[far, :3] = starts + t[:, None] * directions
     out[far, 3] = 1.0
-    out[far, axis] = grown[side, axis]      # exactly on the face
+    out[far, axis] = (1.0 if side else -1.0) * plane  # exactly on the plane
     return out, 2 * axis + side, reach

@@ -297,7 +297,8 @@ class ShadowVolumes:
             return False
         margin = self.margin()
         corners = box_corners(self._box)
-        farthest = float(np.linalg.norm(corners - view.eye, axis=1).max()) + 2.0 * margin
+        # (the cut's plane lies up to two margins past the box: bounded_volume)
+        farthest = float(np.linalg.norm(corners - view.eye, axis=1).max()) + 3.0 * margin
         step = farthest * farthest / (near * float(1 << 24))
         return step * DEPTH_STEPS_IN_MARGIN < margin
 
