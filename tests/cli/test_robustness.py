@@ -464,6 +464,17 @@ def test_mesh_over_the_triangle_limit_is_refused_before_its_normals(tmp_path, ca
     assert built == []
 
 
+def _as_from_a_terminal() -> None:
+    """In the child before exec: SIGINT delivered and handled by default, as for a command a
+    terminal starts. A child inherits an ignored SIGINT and a blocked signal mask from this
+    process; in the full suite the worker had one of them (the trace still ran 240 s after
+    the SIGINT, faulthandler's stacks showed), which no terminal gives."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+
 def test_ctrl_c_exits_130_and_leaves_no_file(tmp_path):
     import signal
     import time
@@ -482,7 +493,8 @@ def test_ctrl_c_exits_130_and_leaves_no_file(tmp_path):
                              _preset(tmp_path, light), "-o", str(out), "--npy",
                              str(tmp_path / "x.npy"), "--size", "256x256", "--spp", "4000"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            env=dict(os.environ, PYTHONFAULTHANDLER="1"))
+                            env=dict(os.environ, PYTHONFAULTHANDLER="1"),
+                            preexec_fn=_as_from_a_terminal)
     time.sleep(6)  # imports, JIT, into the trace
     proc.send_signal(signal.SIGINT)
     # a Ctrl+C that still lands in numba's compiler waits for it: the suite's other worker
@@ -493,7 +505,10 @@ def test_ctrl_c_exits_130_and_leaves_no_file(tmp_path):
     except subprocess.TimeoutExpired:
         proc.send_signal(signal.SIGABRT)          # faulthandler prints every thread's stack
         _, err = proc.communicate()
-        pytest.fail(f"still running 240 s after Ctrl+C:\n{err[-4000:]}")
+        pytest.fail(f"still running 240 s after Ctrl+C (this process: SIGINT "
+                    f"{signal.getsignal(signal.SIGINT)}, blocked "
+                    f"{signal.SIGINT in signal.pthread_sigmask(signal.SIG_BLOCK, [])}):\n"
+                    f"{err[-4000:]}")
     assert proc.returncode == 130, err
     assert "shadelab: interrupted" in err and "Traceback" not in err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["p.toml"]
